@@ -1,0 +1,55 @@
+# Shared build helpers: warnings, sanitizers, IDL generation, tests.
+
+# Compile options every first-party target gets.
+function(rig_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion
+                                           -Wno-sign-conversion)
+  if(RIG_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(RIG_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# rig_generate_idl(OUT_SOURCES_VAR file.idl...): runs fastddsgen at build time into
+# the build tree; generated code is never committed.
+function(rig_generate_idl out_var)
+  set(gen_dir ${CMAKE_CURRENT_BINARY_DIR}/generated)
+  set(sources)
+  foreach(idl IN LISTS ARGN)
+    get_filename_component(stem ${idl} NAME_WE)
+    set(outs ${gen_dir}/${stem}.h ${gen_dir}/${stem}.cxx
+             ${gen_dir}/${stem}PubSubTypes.h ${gen_dir}/${stem}PubSubTypes.cxx)
+    add_custom_command(
+      OUTPUT ${outs}
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${gen_dir}
+      COMMAND ${FASTDDSGEN} -replace -d ${gen_dir} ${CMAKE_CURRENT_SOURCE_DIR}/${idl}
+      DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${idl}
+      COMMENT "fastddsgen ${idl}"
+      VERBATIM)
+    list(APPEND sources ${outs})
+  endforeach()
+  set(${out_var} ${sources} PARENT_SCOPE)
+endfunction()
+
+# rig_add_test(name SOURCES a.cpp b.cpp LIBS rig::x [LABELS dds]): one GoogleTest
+# executable registered with ctest.  Tests labelled `dds` start DDS participants and
+# are run by scripts/test inside a loopback-only network namespace when allowed.
+function(rig_add_test name)
+  cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${T_SOURCES})
+  rig_target_defaults(${name})
+  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE
+    RIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    RIG_SHARED_DIR="${PROJECT_SOURCE_DIR}/../shared"
+    RIG_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  add_test(NAME ${name} COMMAND ${name})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 600)
+  if(T_LABELS)
+    set_tests_properties(${name} PROPERTIES LABELS "${T_LABELS}")
+  endif()
+endfunction()

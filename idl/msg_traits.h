@@ -1,0 +1,31 @@
+#pragma once
+// Maps each generated message type to its fastddsgen PubSubType, so rig::Writer<T>
+// and rig::Reader<T> can register types without the caller naming them twice.
+#include "clockPubSubTypes.h"
+#include "controllerPubSubTypes.h"
+#include "devicePubSubTypes.h"
+#include "truthPubSubTypes.h"
+
+namespace rig {
+
+template <class Msg>
+struct MsgTraits;  // undefined for types not declared in idl/
+
+#define RIG_DECLARE_MSG(Type)                  \
+    template <>                                \
+    struct MsgTraits<msg::Type> {              \
+        using PubSubType = msg::Type##PubSubType; \
+    };
+
+RIG_DECLARE_MSG(ClockTick)
+RIG_DECLARE_MSG(ClockAck)
+RIG_DECLARE_MSG(NmeaSentence)
+RIG_DECLARE_MSG(EncoderCount)
+RIG_DECLARE_MSG(ButtonLevel)
+RIG_DECLARE_MSG(BreakpointEvent)
+RIG_DECLARE_MSG(ControllerStatus)
+RIG_DECLARE_MSG(VehicleTruth)
+
+#undef RIG_DECLARE_MSG
+
+}  // namespace rig

@@ -1,0 +1,39 @@
+#pragma once
+// A node in its own process (the controller under test): started by the harness
+// from the command the case names, its output captured to a log file, stopped at
+// the end, killed if it does not stop.
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <sys/types.h>
+
+namespace rig {
+
+class ChildProcess {
+public:
+    // Starts argv[0] (searched in PATH if it has no '/'), stdout+stderr to log_path.
+    // Throws std::runtime_error naming the command when it cannot be started.
+    ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path);
+    ~ChildProcess();  // terminates if still running
+    ChildProcess(const ChildProcess&) = delete;
+    ChildProcess& operator=(const ChildProcess&) = delete;
+
+    pid_t pid() const { return pid_; }
+    // Non-blocking: nullopt while running, else a description of how it ended.
+    std::optional<std::string> exit_description();
+    // Waits up to `grace` for it to end by itself, then SIGTERM and up to `grace`
+    // again, then SIGKILL. Returns how it ended.
+    std::string stop(std::chrono::milliseconds grace = std::chrono::milliseconds(3000));
+    const std::string& command_line() const { return command_line_; }
+
+private:
+    static std::string describe_status(int status);
+    pid_t pid_ = -1;
+    std::optional<std::string> ended_;
+    std::string command_line_;
+};
+
+}  // namespace rig

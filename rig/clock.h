@@ -1,0 +1,59 @@
+#pragma once
+// The one time abstraction every node uses (DESIGN.md "Time"). Nothing outside
+// rig/ reads the wall clock or sleeps: nodes get the time from a Clock, and in
+// lockstep the harness decides what time it is.
+#include <chrono>
+#include <cstdint>
+#include <limits>
+
+namespace rig {
+
+// Simulated (or real) time since case start, in nanoseconds.
+using TimeNs = std::int64_t;
+inline constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
+constexpr TimeNs seconds_to_ns(double s) { return static_cast<TimeNs>(s * 1e9 + (s >= 0 ? 0.5 : -0.5)); }
+constexpr double ns_to_seconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
+
+class Clock {
+public:
+    virtual ~Clock() = default;
+    virtual TimeNs now_ns() const = 0;
+};
+
+// Lockstep: time only moves when the harness's tick says so.
+class ManualClock final : public Clock {
+public:
+    TimeNs now_ns() const override { return now_ns_; }
+    void set_ns(TimeNs t) { now_ns_ = t; }
+
+private:
+    TimeNs now_ns_ = 0;
+};
+
+// Real time: the wall (monotonic) clock since construction, with absolute-deadline
+// waits so a periodic loop does not drift by its own processing time.
+class RealtimeClock final : public Clock {
+public:
+    RealtimeClock();
+    TimeNs now_ns() const override;
+    // Blocks until now_ns() >= deadline_ns (returns at once if already past).
+    // Returns how late the wake-up was, in ns (>= 0).
+    TimeNs sleep_until_ns(TimeNs deadline_ns) const;
+
+private:
+    std::chrono::steady_clock::time_point start_;
+};
+
+// Wall-clock stopwatch for bounds that must hold in real time even in lockstep
+// (a node that stops answering, a run that must end): never used for simulated time.
+class WallStopwatch {
+public:
+    WallStopwatch();
+    double elapsed_s() const;
+    std::chrono::milliseconds elapsed() const;
+
+private:
+    std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace rig

@@ -1,0 +1,178 @@
+#pragma once
+// One process's DDS entities: a participant from the loopback profile, one
+// publisher, one subscriber, and typed Writer<Msg> / Reader<Msg> endpoints whose
+// QoS the whole project shares (reliable, keep-all, volatile): lockstep time
+// needs every sample delivered before a tick is acknowledged.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "msg_traits.h"
+
+namespace rig {
+
+namespace dds = eprosima::fastdds::dds;
+
+class DdsContext;
+
+// Endpoint-independent part of a writer, so the context can wait for all of them.
+class WriterBase {
+public:
+    virtual ~WriterBase();
+    WriterBase(const WriterBase&) = delete;
+    WriterBase& operator=(const WriterBase&) = delete;
+
+    const std::string& topic_name() const { return topic_name_; }
+    int matched_readers() const { return listener_.matched.load(); }
+    // Blocks until every reader matched now has acknowledged every sample written.
+    bool wait_delivered(std::chrono::milliseconds timeout);
+
+protected:
+    WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output);
+    bool write_raw(void* sample);
+
+private:
+    struct MatchListener : dds::DataWriterListener {
+        std::atomic<int> matched{0};
+        void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override {
+            matched.store(status.current_count);
+        }
+    };
+    DdsContext& context_;
+    std::string topic_name_;
+    MatchListener listener_;
+    dds::DataWriter* writer_ = nullptr;
+    bool counts_as_output_;
+};
+
+// A typed writer on one topic. Each publish() is counted by the context, which is
+// how lockstep knows a node produced output during a tick.
+template <class Msg>
+class Writer final : public WriterBase {
+public:
+    Writer(DdsContext& context, const std::string& topic_name, bool counts_as_output = true);
+    void publish(const Msg& sample) {
+        if (!write_raw(const_cast<Msg*>(&sample))) {
+            throw std::runtime_error("DDS write failed on topic " + topic_name());
+        }
+    }
+};
+
+class ReaderBase {
+public:
+    virtual ~ReaderBase();
+    ReaderBase(const ReaderBase&) = delete;
+    ReaderBase& operator=(const ReaderBase&) = delete;
+
+    const std::string& topic_name() const { return topic_name_; }
+    int matched_writers() const { return listener_.matched.load(); }
+    bool has_unread() const { return reader_->get_unread_count() > 0; }
+    // Blocks (wall time) until a sample is available or the timeout passes.
+    bool wait_for_data(std::chrono::milliseconds timeout);
+
+protected:
+    ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic);
+    // Takes one sample into `sample`; false when the history is empty.
+    bool take_raw(void* sample);
+
+private:
+    struct MatchListener : dds::DataReaderListener {
+        std::atomic<int> matched{0};
+        void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+            matched.store(status.current_count);
+        }
+    };
+    DdsContext& context_;
+    std::string topic_name_;
+    MatchListener listener_;
+    dds::DataReader* reader_ = nullptr;
+};
+
+// A typed reader: take_all() returns every received sample in arrival order
+// (per-writer order is preserved by reliable DDS).
+template <class Msg>
+class Reader final : public ReaderBase {
+public:
+    Reader(DdsContext& context, const std::string& topic_name);
+    std::vector<Msg> take_all() {
+        std::vector<Msg> samples;
+        Msg sample;
+        while (take_raw(&sample)) samples.push_back(sample);
+        return samples;
+    }
+};
+
+class DdsContext {
+public:
+    DdsContext(std::uint32_t domain_id, const std::string& participant_name);
+    ~DdsContext();
+    DdsContext(const DdsContext&) = delete;
+    DdsContext& operator=(const DdsContext&) = delete;
+
+    std::uint32_t domain_id() const { return domain_id_; }
+    dds::DomainParticipant& participant() { return *participant_; }
+    dds::Publisher& publisher() { return *publisher_; }
+    dds::Subscriber& subscriber() { return *subscriber_; }
+
+    template <class Msg>
+    dds::Topic* topic(const std::string& name) {
+        using PubSub = typename MsgTraits<Msg>::PubSubType;
+        return topic_for(name, [] { return dds::TypeSupport(new PubSub()); });
+    }
+
+    // Samples published (by writers that count as output) since the last call.
+    std::uint32_t take_published_count() { return published_count_.exchange(0); }
+    void note_published() { published_count_.fetch_add(1); }
+
+    // Waits until every writer's samples are acknowledged by all matched readers.
+    // Returns the topics that did not make it in time (empty = all delivered).
+    std::vector<std::string> wait_all_delivered(std::chrono::milliseconds timeout);
+
+    // Registry used by wait_all_delivered and endpoint-matching checks.
+    void register_writer(WriterBase* writer);
+    void unregister_writer(WriterBase* writer);
+    void register_reader(ReaderBase* reader);
+    void unregister_reader(ReaderBase* reader);
+    std::vector<WriterBase*> writers() const;
+    std::vector<ReaderBase*> readers() const;
+
+private:
+    dds::Topic* topic_for(const std::string& name, dds::TypeSupport (*make_type)());
+
+    std::uint32_t domain_id_;
+    dds::DomainParticipant* participant_ = nullptr;
+    dds::Publisher* publisher_ = nullptr;
+    dds::Subscriber* subscriber_ = nullptr;
+    std::map<std::string, dds::Topic*> topics_;
+    std::atomic<std::uint32_t> published_count_{0};
+    mutable std::mutex registry_mutex_;
+    std::vector<WriterBase*> writers_;
+    std::vector<ReaderBase*> readers_;
+};
+
+template <class Msg>
+Writer<Msg>::Writer(DdsContext& context, const std::string& topic_name, bool counts_as_output)
+    : WriterBase(context, topic_name, context.topic<Msg>(topic_name), counts_as_output) {}
+
+template <class Msg>
+Reader<Msg>::Reader(DdsContext& context, const std::string& topic_name)
+    : ReaderBase(context, topic_name, context.topic<Msg>(topic_name)) {}
+
+}  // namespace rig

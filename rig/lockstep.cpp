@@ -1,0 +1,323 @@
+#include "rig/lockstep.h"
+
+#include <algorithm>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "idl/topics.h"
+
+namespace rig {
+
+namespace {
+
+constexpr std::chrono::milliseconds kPollSlice{50};
+// Rounds at one instant before we call it a feedback loop between nodes.
+constexpr int kMaxRoundsPerInstant = 64;
+
+std::vector<std::string> split_topics(const std::string& joined) {
+    std::vector<std::string> topics;
+    std::stringstream stream(joined);
+    std::string topic;
+    while (std::getline(stream, topic, ',')) {
+        if (!topic.empty()) topics.push_back(topic);
+    }
+    return topics;
+}
+
+std::string format_time(TimeNs t) {
+    std::ostringstream out;
+    out.setf(std::ios::fixed);
+    out.precision(3);
+    out << ns_to_seconds(t) << " s";
+    return out.str();
+}
+
+}  // namespace
+
+LockstepMaster::LockstepMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), timeouts_(timeouts) {}
+
+LockstepMaster::~LockstepMaster() { shutdown(); }
+
+void LockstepMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0}); }
+
+void LockstepMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
+    remotes_.push_back(Remote{name, std::move(liveness), 0, {}});
+}
+
+void LockstepMaster::start() {
+    tick_writer_ = std::make_unique<Writer<msg::ClockTick>>(dds_, topics::kClockTick, false);
+    ack_reader_ = std::make_unique<Reader<msg::ClockAck>>(dds_, topics::kClockAck);
+    for (Local& local : locals_) local.node->configure(dds_);
+
+    const WallStopwatch waited;
+    auto check_startup = [&](const std::string& what) {
+        for (const Remote& remote : remotes_) {
+            if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) throw NodeFailure(remote.name, *gone);
+        }
+        if (waited.elapsed() > timeouts_.startup) {
+            std::string names;
+            for (const Remote& remote : remotes_) names += (names.empty() ? "" : ", ") + remote.name;
+            throw NodeFailure(names.empty() ? "harness" : names,
+                              what + " not done within " + std::to_string(timeouts_.startup.count()) + " ms");
+        }
+    };
+
+    if (!remotes_.empty()) {
+        const int expected = static_cast<int>(remotes_.size());
+        while (tick_writer_->matched_readers() < expected || ack_reader_->matched_writers() < expected) {
+            check_startup("DDS discovery of the clock topics");
+            ack_reader_->wait_for_data(kPollSlice);
+        }
+        // Hello: seq 0.
+        tick_remotes(0, false);
+    }
+
+    // Every writer must reach every reader of its topic (local ones and the remotes
+    // that said they read it) before time starts, or early samples would be lost.
+    for (WriterBase* writer : dds_.writers()) {
+        if (writer == tick_writer_.get()) continue;
+        int expected = 0;
+        for (ReaderBase* reader : dds_.readers()) expected += reader->topic_name() == writer->topic_name();
+        for (const Remote& remote : remotes_) {
+            expected += static_cast<int>(std::count(remote.subscribed_topics.begin(), remote.subscribed_topics.end(),
+                                                    writer->topic_name()));
+        }
+        while (writer->matched_readers() < expected) {
+            check_startup("matching of topic " + writer->topic_name() + " (" +
+                          std::to_string(writer->matched_readers()) + "/" + std::to_string(expected) + " readers)");
+            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+        }
+    }
+    for (Local& local : locals_) local.node->activate(0);
+    started_ = true;
+}
+
+void LockstepMaster::wait_local_delivery(TimeNs t) {
+    // In slices, so a reader that died is reported as such rather than as slow.
+    const WallStopwatch waited;
+    for (;;) {
+        const auto late = dds_.wait_all_delivered(kPollSlice);
+        if (late.empty()) return;
+        for (const Remote& remote : remotes_) {
+            if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) {
+                throw NodeFailure(remote.name, *gone + " (at t=" + format_time(t) + ")");
+            }
+        }
+        if (waited.elapsed() > timeouts_.delivery) {
+            std::string topics;
+            for (const auto& topic : late) topics += (topics.empty() ? "" : ", ") + topic;
+            std::string readers;
+            for (const Remote& remote : remotes_) readers += (readers.empty() ? "" : ", ") + remote.name;
+            throw NodeFailure(readers.empty() ? "harness" : readers,
+                              "did not acknowledge samples on " + topics + " at t=" + format_time(t) + " within " +
+                                  std::to_string(timeouts_.delivery.count()) + " ms");
+        }
+    }
+}
+
+std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
+    msg::ClockTick tick;
+    tick.seq(seq_);
+    tick.time_ns(t);
+    tick.shutdown(shutdown);
+    const std::uint64_t seq = seq_++;
+    tick_writer_->publish(tick);
+
+    const bool hello = seq == 0;
+    const auto limit = hello ? timeouts_.startup : timeouts_.ack;
+    std::vector<bool> answered(remotes_.size(), false);
+    std::size_t outstanding = remotes_.size();
+    std::uint32_t published = 0;
+    const WallStopwatch waited;
+    while (outstanding > 0) {
+        ack_reader_->wait_for_data(std::min(kPollSlice, limit));
+        for (const msg::ClockAck& ack : ack_reader_->take_all()) {
+            if (ack.seq() != seq) continue;  // a late answer to an older tick
+            for (std::size_t i = 0; i < remotes_.size(); ++i) {
+                if (answered[i] || remotes_[i].name != ack.node_name().to_string()) continue;
+                if (ack.fatal_error().size() > 0) throw NodeFailure(remotes_[i].name, ack.fatal_error().to_string());
+                answered[i] = true;
+                --outstanding;
+                remotes_[i].next_wake_ns = ack.next_wake_ns();
+                published += ack.published_count();
+                if (hello) remotes_[i].subscribed_topics = split_topics(ack.subscribed_topics().to_string());
+            }
+        }
+        if (outstanding == 0) break;
+        for (std::size_t i = 0; i < remotes_.size(); ++i) {
+            if (answered[i]) continue;
+            if (auto gone = remotes_[i].liveness ? remotes_[i].liveness() : std::nullopt) {
+                throw NodeFailure(remotes_[i].name, *gone + " (waiting for tick " + std::to_string(seq) +
+                                                        " at t=" + format_time(t) + ")");
+            }
+            if (waited.elapsed() > limit) {
+                throw NodeFailure(remotes_[i].name, "did not acknowledge " +
+                                                        std::string(shutdown ? "the shutdown tick" : "tick ") +
+                                                        (shutdown ? "" : std::to_string(seq)) + " at t=" +
+                                                        format_time(t) + " within " +
+                                                        std::to_string(limit.count()) + " ms");
+            }
+        }
+    }
+    return published;
+}
+
+std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
+    if (!started_) throw std::logic_error("LockstepMaster::advance before start");
+    TimeNs t = kNever;
+    for (const Local& local : locals_) t = std::min(t, local.next_wake_ns);
+    for (const Remote& remote : remotes_) t = std::min(t, remote.next_wake_ns);
+    if (t == kNever || t > until_ns) return std::nullopt;
+    t = std::max(t, now_ns_);  // a node asking for the past is due now
+    now_ns_ = t;
+
+    std::uint32_t published_by_remotes = 0;
+    for (int round = 0;; ++round) {
+        if (round >= kMaxRoundsPerInstant) {
+            throw NodeFailure("harness", "nodes kept answering each other at t=" + format_time(t) + " for " +
+                                             std::to_string(kMaxRoundsPerInstant) + " rounds (a feedback loop)");
+        }
+        for (Local& local : locals_) {
+            const bool due = round == 0 && local.next_wake_ns <= t;
+            if (due || local.node->has_unread_input()) local.next_wake_ns = local.node->step(t);
+        }
+        wait_local_delivery(t);
+        const std::uint32_t published_by_locals = dds_.take_published_count();
+
+        bool remote_due = false;
+        for (const Remote& remote : remotes_) remote_due |= round == 0 && remote.next_wake_ns <= t;
+        published_by_remotes = 0;
+        if (!remotes_.empty() && (remote_due || published_by_locals > 0)) {
+            published_by_remotes = tick_remotes(t, false);
+        }
+        if (after_round_) after_round_(t, round);
+        if (published_by_remotes == 0) {
+            // Local nodes may still hold input that arrived from other local nodes.
+            bool pending = false;
+            for (const Local& local : locals_) pending |= local.node->has_unread_input();
+            if (!pending) break;
+        }
+    }
+    return t;
+}
+
+void LockstepMaster::shutdown() noexcept {
+    if (shut_down_) return;
+    shut_down_ = true;
+    if (started_ && !remotes_.empty()) {
+        try {
+            tick_remotes(now_ns_, true);
+        } catch (const std::exception& error) {
+            std::cerr << "rig: during shutdown: " << error.what() << "\n";
+        }
+    }
+    for (auto it = locals_.rbegin(); it != locals_.rend(); ++it) {
+        try {
+            it->node->shutdown();
+        } catch (const std::exception& error) {
+            std::cerr << "rig: shutting down node '" << it->node->name() << "': " << error.what() << "\n";
+        }
+    }
+}
+
+int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options) {
+    std::unique_ptr<Reader<msg::ClockTick>> tick_reader;
+    std::unique_ptr<Writer<msg::ClockAck>> ack_writer;
+    try {
+        tick_reader = std::make_unique<Reader<msg::ClockTick>>(dds, topics::kClockTick);
+        ack_writer = std::make_unique<Writer<msg::ClockAck>>(dds, topics::kClockAck, false);
+        node.configure(dds);
+    } catch (const std::exception& error) {
+        std::cerr << options.node_name << ": configure failed: " << error.what() << "\n";
+        return 2;
+    }
+
+    auto send_ack = [&](std::uint64_t seq, TimeNs next_wake, std::uint32_t published, const std::string& topics,
+                        const std::string& fatal) {
+        msg::ClockAck ack;
+        ack.node_name(options.node_name);
+        ack.seq(seq);
+        ack.next_wake_ns(next_wake);
+        ack.published_count(published);
+        ack.subscribed_topics(topics);
+        ack.fatal_error(fatal.substr(0, 1000));
+        ack_writer->publish(ack);
+    };
+
+    // Every endpoint must be matched before we say hello; a node reading a topic no
+    // one writes is a configuration error the master reports with our name.
+    const WallStopwatch startup;
+    for (;;) {
+        std::vector<std::string> unmatched;
+        for (ReaderBase* reader : dds.readers()) {
+            if (reader->matched_writers() < 1) unmatched.push_back("reads " + reader->topic_name());
+        }
+        for (WriterBase* writer : dds.writers()) {
+            if (writer->matched_readers() < 1) unmatched.push_back("writes " + writer->topic_name());
+        }
+        if (unmatched.empty()) break;
+        if (startup.elapsed() > options.startup_timeout) {
+            std::string list;
+            for (const auto& item : unmatched) list += (list.empty() ? "" : "; ") + item;
+            std::cerr << options.node_name << ": no DDS counterpart within " << options.startup_timeout.count()
+                      << " ms for: " << list << "\n";
+            return 3;
+        }
+        tick_reader->wait_for_data(std::chrono::milliseconds(5));
+    }
+
+    bool activated = false;
+    WallStopwatch idle;
+    for (;;) {
+        if (!tick_reader->wait_for_data(kPollSlice)) {
+            if (idle.elapsed() > options.idle_timeout) {
+                std::cerr << options.node_name << ": no tick from the harness for " << options.idle_timeout.count()
+                          << " ms; exiting\n";
+                return 4;
+            }
+            continue;
+        }
+        idle = WallStopwatch();
+        for (const msg::ClockTick& tick : tick_reader->take_all()) {
+            if (tick.seq() == 0) {
+                std::string topics;
+                for (ReaderBase* reader : dds.readers()) {
+                    if (reader == tick_reader.get()) continue;
+                    topics += (topics.empty() ? "" : ",") + reader->topic_name();
+                }
+                send_ack(0, 0, 0, topics, "");
+                continue;
+            }
+            if (tick.shutdown()) {
+                node.shutdown();
+                send_ack(tick.seq(), kNever, 0, "", "");
+                ack_writer->wait_delivered(options.delivery_timeout);
+                return 0;
+            }
+            clock.set_ns(tick.time_ns());
+            dds.take_published_count();
+            TimeNs next_wake = kNever;
+            try {
+                if (!activated) {
+                    node.activate(tick.time_ns());
+                    activated = true;
+                }
+                next_wake = node.step(tick.time_ns());
+            } catch (const std::exception& error) {
+                send_ack(tick.seq(), kNever, 0, "", error.what());
+                ack_writer->wait_delivered(options.delivery_timeout);
+                std::cerr << options.node_name << ": " << error.what() << "\n";
+                return 2;
+            }
+            const auto late = dds.wait_all_delivered(options.delivery_timeout);
+            if (!late.empty()) {
+                send_ack(tick.seq(), kNever, 0, "", "samples on " + late.front() + " not acknowledged in time");
+                return 5;
+            }
+            send_ack(tick.seq(), next_wake, dds.take_published_count(), "", "");
+        }
+    }
+}
+
+}  // namespace rig

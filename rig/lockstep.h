@@ -1,0 +1,118 @@
+#pragma once
+// Lockstep virtual time over DDS (DESIGN.md "Time").
+//
+// Protocol, per simulated instant t:
+//   round 0: the master steps every local node due at t, waits until their
+//            samples are delivered, then sends ClockTick{seq, t} to the remote
+//            nodes if one of them is due or anything was published; each remote
+//            node takes its inputs, steps, waits for its samples to be
+//            acknowledged (wait_for_acknowledgments), then answers ClockAck{seq,
+//            next_wake, published_count}.
+//   round r>0: while the previous round published anything, nodes with unread
+//            input run again at the same t. A sample published at t is therefore
+//            seen by its readers at t; delays come only from the models.
+// Then the master jumps to the earliest next_wake of all nodes: idle simulated
+// time costs nothing. Tick 0 is a hello: the remote answers once all its
+// endpoints are matched, listing the topics it reads so the master can wait for
+// its own writers to reach them. A remote that does not answer within the
+// wall-time bound, or whose process ends, fails the run with its name.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "rig/clock.h"
+#include "rig/dds_context.h"
+#include "rig/node.h"
+
+namespace rig {
+
+// A node failed: did not answer in time, died, or reported a fatal error.
+class NodeFailure : public std::runtime_error {
+public:
+    NodeFailure(std::string node_name, const std::string& what)
+        : std::runtime_error("node '" + node_name + "': " + what), node_name_(std::move(node_name)) {}
+    const std::string& node_name() const { return node_name_; }
+
+private:
+    std::string node_name_;
+};
+
+struct LockstepTimeouts {
+    std::chrono::milliseconds ack{10'000};        // a remote must answer a tick within this
+    std::chrono::milliseconds startup{30'000};    // discovery + hello
+    std::chrono::milliseconds delivery{10'000};   // wait_for_acknowledgments bound
+};
+
+// Master side, in the harness process.
+class LockstepMaster {
+public:
+    LockstepMaster(DdsContext& dds, LockstepTimeouts timeouts);
+    ~LockstepMaster();
+
+    // Local nodes run in the master's process and are stepped in the order added.
+    void add_local_node(Node& node);
+    // A remote node (its own process). `liveness` returns an error text when the
+    // node is known to be gone (e.g. its process exited), checked while waiting.
+    void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
+    // Called after every round with (t, round): the recorder drains its readers here.
+    void set_after_round(std::function<void(TimeNs, int)> callback) { after_round_ = std::move(callback); }
+
+    // Configure local nodes, wait for remote hellos and endpoint matching, activate.
+    void start();
+    // Processes the earliest instant <= until_ns; returns it, or nullopt when the
+    // next wake-up is later than until_ns (the run is over).
+    std::optional<TimeNs> advance(TimeNs until_ns);
+    // Sends the shutdown tick, waits (bounded) for the remotes' last acks, shuts
+    // local nodes down in reverse order. Never throws.
+    void shutdown() noexcept;
+
+    std::uint64_t ticks_sent() const { return seq_; }
+    TimeNs now_ns() const { return now_ns_; }
+
+private:
+    struct Remote {
+        std::string name;
+        std::function<std::optional<std::string>()> liveness;
+        TimeNs next_wake_ns = 0;
+        std::vector<std::string> subscribed_topics;
+    };
+    struct Local {
+        Node* node;
+        TimeNs next_wake_ns = 0;
+    };
+    // Sends one tick and collects every remote's ack; returns samples they published.
+    std::uint32_t tick_remotes(TimeNs t, bool shutdown);
+    void wait_local_delivery(TimeNs t);
+
+    DdsContext& dds_;
+    LockstepTimeouts timeouts_;
+    std::vector<Local> locals_;
+    std::vector<Remote> remotes_;
+    std::unique_ptr<Writer<msg::ClockTick>> tick_writer_;
+    std::unique_ptr<Reader<msg::ClockAck>> ack_reader_;
+    std::function<void(TimeNs, int)> after_round_;
+    std::uint64_t seq_ = 0;
+    TimeNs now_ns_ = 0;
+    bool started_ = false;
+    bool shut_down_ = false;
+};
+
+struct FollowerOptions {
+    std::string node_name;
+    // The harness is gone if no tick arrives for this long: exit instead of hanging.
+    std::chrono::milliseconds idle_timeout{120'000};
+    std::chrono::milliseconds startup_timeout{30'000};
+    std::chrono::milliseconds delivery_timeout{10'000};
+};
+
+// Follower side: runs `node` in this process under the master's ticks until the
+// shutdown tick. Returns a process exit code (0 = clean shutdown) and prints the
+// reason for any other to stderr.
+int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options);
+
+}  // namespace rig

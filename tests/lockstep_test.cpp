@@ -1,0 +1,125 @@
+// Lockstep master/follower over real DDS (loopback profile) with a remote echo
+// node in its own process (tests/lockstep_test_node.cpp).
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "rig/child_process.h"
+#include "rig/dds_context.h"
+#include "rig/domain_lease.h"
+#include "rig/lockstep.h"
+
+namespace {
+
+// Publishes "ping" every 10 ms of simulated time.
+class Pinger final : public rig::Node {
+public:
+    const std::string& name() const override { return name_; }
+    void configure(rig::DdsContext& dds) override {
+        writer_ = std::make_unique<rig::Writer<rig::msg::NmeaSentence>>(dds, "test/ping");
+    }
+    rig::TimeNs step(rig::TimeNs now_ns) override {
+        rig::msg::NmeaSentence ping;
+        ping.sentence("ping " + std::to_string(now_ns));
+        writer_->publish(ping);
+        return now_ns + 10'000'000;
+    }
+
+private:
+    std::string name_ = "pinger";
+    std::unique_ptr<rig::Writer<rig::msg::NmeaSentence>> writer_;
+};
+
+struct RemoteEcho {
+    rig::DomainLease lease = rig::DomainLease::acquire();
+    std::unique_ptr<rig::ChildProcess> process;
+    explicit RemoteEcho(const std::string& extra_flag = "", const std::string& extra_value = "") {
+        std::vector<std::string> argv{RIG_LOCKSTEP_TEST_NODE, "--domain", std::to_string(lease.domain_id()),
+                                      "--node-name", "echo"};
+        if (!extra_flag.empty()) {
+            argv.push_back(extra_flag);
+            argv.push_back(extra_value);
+        }
+        process = std::make_unique<rig::ChildProcess>(argv, ::testing::TempDir() + "/echo-node.log");
+    }
+};
+
+std::map<rig::TimeNs, std::string> run_echo_case(rig::TimeNs end_ns) {
+    RemoteEcho echo;
+    rig::DdsContext dds(echo.lease.domain_id(), "harness");
+    Pinger pinger;
+    rig::Reader<rig::msg::NmeaSentence> pongs(dds, "test/pong");
+    std::map<rig::TimeNs, std::string> seen;
+    rig::LockstepMaster master(dds, rig::LockstepTimeouts{});
+    master.add_local_node(pinger);
+    master.add_remote_node("echo", [&] { return echo.process->exit_description(); });
+    master.set_after_round([&](rig::TimeNs t, int) {
+        for (const auto& pong : pongs.take_all()) seen[t] += pong.sentence().to_string() + ";";
+    });
+    master.start();
+    while (master.advance(end_ns)) {
+    }
+    master.shutdown();
+    EXPECT_EQ(echo.process->stop(), "process exited with status 0");
+    return seen;
+}
+
+TEST(Lockstep, SamplePublishedAtTIsSeenAtTAndRunsAreIdentical) {
+    const auto first = run_echo_case(500'000'000);
+    ASSERT_EQ(first.size(), 51u);  // pings at 0, 10, ..., 500 ms
+    for (const auto& [t, text] : first) {
+        // The echo of the ping sent at t came back at the same simulated t.
+        EXPECT_NE(text.find("ping " + std::to_string(t) + " #"), std::string::npos) << text;
+        EXPECT_NE(text.find("@" + std::to_string(t) + ";"), std::string::npos) << text;
+    }
+    const auto second = run_echo_case(500'000'000);
+    EXPECT_EQ(first, second);
+}
+
+TEST(Lockstep, NodeThatStopsAnsweringFailsByNameInBoundedTime) {
+    RemoteEcho echo("--stall-at-ms", "200");
+    rig::DdsContext dds(echo.lease.domain_id(), "harness");
+    Pinger pinger;
+    rig::Reader<rig::msg::NmeaSentence> pongs(dds, "test/pong");
+    rig::LockstepTimeouts timeouts;
+    timeouts.ack = std::chrono::milliseconds(1500);
+    rig::LockstepMaster master(dds, timeouts);
+    master.add_local_node(pinger);
+    master.add_remote_node("echo", [&] { return echo.process->exit_description(); });
+    master.start();
+    const rig::WallStopwatch wall;
+    try {
+        while (master.advance(10'000'000'000)) {
+        }
+        FAIL() << "the stalled node was not detected";
+    } catch (const rig::NodeFailure& failure) {
+        EXPECT_EQ(failure.node_name(), "echo");
+        EXPECT_NE(std::string(failure.what()).find("did not acknowledge tick"), std::string::npos) << failure.what();
+        EXPECT_NE(std::string(failure.what()).find("t=0.200 s"), std::string::npos) << failure.what();
+    }
+    EXPECT_LT(wall.elapsed_s(), 30.0);
+    echo.process->stop(std::chrono::milliseconds(500));
+}
+
+TEST(Lockstep, NodeProcessThatDiesFailsByName) {
+    RemoteEcho echo;
+    rig::DdsContext dds(echo.lease.domain_id(), "harness");
+    Pinger pinger;
+    rig::Reader<rig::msg::NmeaSentence> pongs(dds, "test/pong");
+    rig::LockstepMaster master(dds, rig::LockstepTimeouts{});
+    master.add_local_node(pinger);
+    master.add_remote_node("echo", [&] { return echo.process->exit_description(); });
+    master.start();
+    ASSERT_TRUE(master.advance(1'000'000'000));
+    ::kill(echo.process->pid(), SIGKILL);
+    try {
+        while (master.advance(10'000'000'000)) {
+        }
+        FAIL() << "the dead node was not detected";
+    } catch (const rig::NodeFailure& failure) {
+        EXPECT_EQ(failure.node_name(), "echo");
+        EXPECT_NE(std::string(failure.what()).find("signal 9"), std::string::npos) << failure.what();
+    }
+}
+
+}  // namespace
