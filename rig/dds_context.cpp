@@ -21,9 +21,11 @@ dds::DataWriterQos project_writer_qos(dds::Publisher& publisher) {
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
     qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-    // Short heartbeats: a lost acknowledgement is repaired in milliseconds rather
-    // than Fast DDS's default 3 s, which would stall a lockstep tick.
-    qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 20'000'000);
+    // Readers acknowledge in answer to a heartbeat, and wait_for_acknowledgments
+    // waits for that: the heartbeat period is the floor of every lockstep round.
+    // Fast DDS's default (3 s) would make each tick take seconds; heartbeats are
+    // only sent while samples are unacknowledged, so a short period costs nothing idle.
+    qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200'000);
     qos.reliable_writer_qos().times.initialHeartbeatDelay = eprosima::fastrtps::Duration_t(0, 1'000'000);
     qos.reliable_writer_qos().times.nackResponseDelay = eprosima::fastrtps::Duration_t(0, 0);
     qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;

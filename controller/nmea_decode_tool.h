@@ -1,0 +1,19 @@
+// `rig nmea decode FILE|-`: decodes a stream of NMEA lines (a receiver capture,
+// a gpsd regression log) into one JSON object per line, for people and scripts.
+#pragma once
+
+#include <iosfwd>
+
+namespace rig::nmea {
+
+// Reads `in` line by line and writes one JSON object per input line to `out`:
+// the decoded sentence, e.g.
+//   {"talker":"GP","type":"GGA","decoded":true,"utc_time":"12:35:19.000",...}
+// (only the fields present in the sentence; undecoded types carry "fields"), or
+//   {"error":"<message>","code":"<ParseErrorCode>","line":N}   (N is 1-based).
+// Blank lines and lines starting with '#' (comments in the gpsd logs) produce
+// nothing.  Lines of any length and any bytes are fine.
+// Returns 0 if every non-skipped line decoded, 1 otherwise.
+int decode_stream(std::istream& in, std::ostream& out);
+
+}  // namespace rig::nmea

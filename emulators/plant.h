@@ -1,0 +1,63 @@
+#pragma once
+// The plant: vehicle on the A-B line, boom geometry, land wheel. It is the single
+// source of truth; emulators sample it (ArduPilot-SITL style, in process) and the
+// PlantNode publishes it on truth/vehicle for the harness and the trace.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "emulators/field_frame.h"
+#include "emulators/land_wheel.h"
+#include "emulators/vehicle_plant.h"
+#include "rig/clock.h"
+#include "rig/dds_context.h"
+#include "rig/node.h"
+
+namespace rig::emulators {
+
+struct PlantParams {
+    double origin_lat_deg = 40.18;
+    double origin_lon_deg = 116.44;
+    double origin_height_m = 50.0;
+    double heading_deg = 90.0;
+    BoomGeometry boom{};
+    std::vector<RoutePhase> route;
+    double start_nozzle_line_along_m = 0.0;
+    LandWheelParams wheel{};
+    std::uint64_t seed = 1;
+};
+
+class Plant {
+public:
+    explicit Plant(const PlantParams& params);
+
+    const FieldFrame& field() const { return field_; }
+    const VehiclePlant& vehicle() const { return vehicle_; }
+    const BoomGeometry& boom() const { return params_.boom; }
+    const LandWheel& land_wheel() const { return wheel_; }
+    // Complete truth at time t (a pure function of t and the seed).
+    msg::VehicleTruth truth_at(TimeNs t) const;
+
+private:
+    PlantParams params_;
+    FieldFrame field_;
+    VehiclePlant vehicle_;
+    LandWheel wheel_;
+};
+
+// Publishes truth/vehicle at a fixed rate for the trace and the report.
+class PlantNode final : public Node {
+public:
+    PlantNode(const Plant& plant, double truth_rate_hz);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+
+private:
+    std::string name_ = "plant";
+    const Plant& plant_;
+    TimeNs period_ns_;
+    std::unique_ptr<Writer<msg::VehicleTruth>> truth_writer_;
+};
+
+}  // namespace rig::emulators

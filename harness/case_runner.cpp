@@ -1,0 +1,268 @@
+#include "harness/case_runner.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <yaml-cpp/yaml.h>
+
+#include "controller/controller_config.h"
+#include "emulators/breakpoint_button.h"
+#include "emulators/gnss_g970.h"
+#include "emulators/plant.h"
+#include "emulators/wheel_encoder.h"
+#include "harness/metrics.h"
+#include "harness/trace_recorder.h"
+#include "rig/child_process.h"
+#include "rig/domain_lease.h"
+#include "rig/lockstep.h"
+
+namespace rig::harness {
+
+namespace {
+
+// How the case's scenario becomes a route (seed 000 sec. 2.5.1): a first pass
+// sprays up to the breakpoint and stops there; the operator presses the button;
+// the sprayer turns at the headland (not simulated: it reappears at start_m) and
+// approaches the breakpoint again, driving `overrun_m` past it.
+constexpr double kFirstPassLengthM = 10.0;
+constexpr double kStandAfterButtonS = 1.0;
+constexpr double kStandBeforeApproachS = 2.0;
+constexpr double kTruthRateHz = 20.0;
+
+struct Scenario {
+    std::vector<emulators::RoutePhase> route;
+    double start_along_m = 0.0;  // nozzle line at t = 0
+    double button_at_s = 0.0;
+    double approach_starts_s = 0.0;
+};
+
+Scenario build_scenario(const CaseSpec& spec, const emulators::BoomGeometry& boom) {
+    const double cruise_m_s = spec.vehicle.speed_km_h / 3.6;
+    const double bp = spec.breakpoint.along_m;
+    Scenario scenario;
+    scenario.start_along_m = bp - kFirstPassLengthM;
+    scenario.route.push_back(emulators::DrivePhase{bp, cruise_m_s, spec.vehicle.accel_m_s2});
+    const double stop_s = emulators::VehiclePlant(scenario.route, boom, scenario.start_along_m).end_time_s();
+    scenario.button_at_s = stop_s + spec.breakpoint.button_at_s;
+    scenario.approach_starts_s = scenario.button_at_s + kStandAfterButtonS;
+    scenario.route.push_back(emulators::StandPhase{spec.breakpoint.button_at_s + kStandAfterButtonS});
+    scenario.route.push_back(emulators::RepositionPhase{spec.vehicle.start_m});
+    scenario.route.push_back(emulators::StandPhase{kStandBeforeApproachS});
+    scenario.route.push_back(
+        emulators::DrivePhase{bp + spec.vehicle.overrun_m, cruise_m_s, spec.vehicle.accel_m_s2});
+    return scenario;
+}
+
+emulators::GnssFixKind to_fix_kind(GnssFix fix) {
+    switch (fix) {
+        case GnssFix::rtk_fixed: return emulators::GnssFixKind::rtk_fixed;
+        case GnssFix::rtk_float: return emulators::GnssFixKind::rtk_float;
+        case GnssFix::dgps: return emulators::GnssFixKind::dgps;
+        case GnssFix::autonomous: return emulators::GnssFixKind::autonomous;
+    }
+    return emulators::GnssFixKind::rtk_fixed;
+}
+
+emulators::G970Params gnss_params(const CaseSpec& spec, std::uint64_t seed, double breakpoint_crossing_s) {
+    emulators::G970Params params;
+    std::string talker(to_string(spec.gnss.talker));
+    std::transform(talker.begin(), talker.end(), talker.begin(), [](unsigned char c) { return std::toupper(c); });
+    params.talker = talker;
+    params.rate_hz = spec.gnss.rate_hz;
+    params.latency_s = spec.gnss.latency_s;
+    params.fix = to_fix_kind(spec.gnss.fix);
+    params.noise_base_m = spec.gnss.noise.base_m;
+    params.noise_ppm = spec.gnss.noise.ppm;
+    params.baseline_km = spec.gnss.noise.baseline_km;
+    for (const GnssDropout& dropout : spec.gnss.dropouts) {
+        const double at_s =
+            dropout.before_breakpoint_s ? breakpoint_crossing_s - *dropout.before_breakpoint_s : dropout.at_s;
+        params.dropouts.push_back(emulators::GnssEpisode{at_s, dropout.for_s});
+    }
+    for (const GnssDegraded& degraded : spec.gnss.degraded) {
+        params.degraded.push_back(
+            emulators::GnssEpisode{degraded.at_s, degraded.for_s, to_fix_kind(degraded.fix), degraded.sigma_m});
+    }
+    // UTC of sim time 0, from the case's utc_start.
+    const auto start_day = std::chrono::floor<std::chrono::days>(spec.utc_start);
+    const std::chrono::year_month_day ymd{start_day};
+    params.utc_year = static_cast<int>(ymd.year());
+    params.utc_month = static_cast<int>(static_cast<unsigned>(ymd.month()));
+    params.utc_day = static_cast<int>(static_cast<unsigned>(ymd.day()));
+    params.utc_start_seconds_of_day =
+        std::chrono::duration<double>(spec.utc_start - std::chrono::sys_time<std::chrono::nanoseconds>(start_day))
+            .count();
+    params.seed = seed;
+    return params;
+}
+
+// The controller's parameters as their own YAML file (the case section minus `command`).
+void write_controller_config(const CaseSpec& spec, const std::filesystem::path& file) {
+    YAML::Node section = spec.controller.params.present ? YAML::Clone(spec.controller.params.node) : YAML::Node();
+    if (section.IsMap()) section.remove("command");
+    YAML::Emitter out;
+    out << section;
+    std::ofstream(file) << "# the `controller:` section of " << spec.source_path.string() << "\n"
+                        << (section.IsNull() ? "{}" : out.c_str()) << "\n";
+}
+
+std::string log_tail(const std::filesystem::path& log, std::size_t max_lines = 6) {
+    std::ifstream in(log);
+    std::vector<std::string> lines;
+    std::string line;
+    while (std::getline(in, line)) {
+        lines.push_back(line);
+        if (lines.size() > max_lines) lines.erase(lines.begin());
+    }
+    std::string tail;
+    for (const auto& kept : lines) tail += "\n    | " + kept;
+    return tail;
+}
+
+}  // namespace
+
+void validate_for_run(const CaseSpec& spec, const RunOptions& /*options*/) {
+    if (spec.mode == RunMode::realtime) {
+        throw ConfigError(SourceLocation{spec.source_path.string(), 0, 0, "mode"},
+                          "realtime runs of whole cases are not implemented yet (lockstep only)");
+    }
+    // The reference controller's own keys are checked before anything starts; a
+    // case naming another controller leaves its section to that controller.
+    if (spec.controller.command.empty()) {
+        controller::parse_controller_config(YamlSection(spec.controller.params));
+    }
+}
+
+CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
+    const WallStopwatch wall;
+    CaseResult result;
+    result.name = spec.name;
+    result.file = spec.source_path.string();
+    result.seed = options.seed_override.value_or(spec.seed);
+    result.limits = effective_limits(spec);
+    const std::filesystem::path case_dir = options.out_dir / "cases" / spec.name;
+
+    try {
+        std::filesystem::remove_all(case_dir);
+        std::filesystem::create_directories(case_dir / "controller-state");
+
+        emulators::PlantParams plant_params;
+        plant_params.origin_lat_deg = spec.field.origin.lat_deg;
+        plant_params.origin_lon_deg = spec.field.origin.lon_deg;
+        plant_params.origin_height_m = spec.field.origin.height_m;
+        plant_params.heading_deg = spec.field.heading_deg;
+        plant_params.boom = emulators::BoomGeometry{spec.boom.l1_m, spec.boom.l2_m, spec.boom.l3_m,
+                                                    spec.boom.linkage_rise_m};
+        const Scenario scenario = build_scenario(spec, plant_params.boom);
+        plant_params.route = scenario.route;
+        plant_params.start_nozzle_line_along_m = scenario.start_along_m;
+        plant_params.wheel.slip_pct = spec.encoder.slip_pct;
+        plant_params.wheel.slip_sd_pct = spec.encoder.slip_sd_pct;
+        plant_params.seed = result.seed;
+        const emulators::Plant plant(plant_params);
+
+        const double crossing_s =
+            plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m, scenario.approach_starts_s);
+        const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
+
+        emulators::GnssG970 gnss(plant, gnss_params(spec, result.seed, crossing_s));
+        emulators::WheelEncoder encoder(
+            plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev, spec.encoder.wheel_diameter_m,
+                                                 spec.encoder.rate_hz});
+        emulators::BreakpointButton button({emulators::ButtonPress{scenario.button_at_s, 0.2}});
+        emulators::PlantNode plant_node(plant, kTruthRateHz);
+
+        // The controller under test, in its own process on this run's own domain.
+        const DomainLease lease = DomainLease::acquire();
+        write_controller_config(spec, case_dir / "controller.yaml");
+        std::vector<std::string> argv = spec.controller.command;
+        if (argv.empty()) argv.push_back(options.controller_executable.string());
+        for (const std::string& arg :
+             {std::string("--domain"), std::to_string(lease.domain_id()), std::string("--node-name"),
+              std::string("controller"), std::string("--config"), (case_dir / "controller.yaml").string(),
+              std::string("--state-dir"), (case_dir / "controller-state").string()}) {
+            argv.push_back(arg);
+        }
+        const std::filesystem::path controller_log = case_dir / "controller.log";
+        ChildProcess controller(argv, controller_log);
+
+        DdsContext dds(lease.domain_id(), "harness");
+        TraceRecorder trace(dds, case_dir / "trace.sqlite");
+        trace.set_meta("case", spec.name);
+        trace.set_meta("case_file", spec.source_path.string());
+        trace.set_meta("seed", std::to_string(result.seed));
+        trace.set_meta("controller_command", controller.command_line());
+
+        LockstepTimeouts timeouts;
+        timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
+        LockstepMaster master(dds, timeouts);
+        // Local nodes step in this order each instant: plant truth first.
+        master.add_local_node(plant_node);
+        master.add_local_node(gnss);
+        master.add_local_node(encoder);
+        master.add_local_node(button);
+        master.add_remote_node("controller", [&controller] { return controller.exit_description(); });
+        master.set_after_round([&trace](TimeNs t, int round) { trace.drain(t, round); });
+
+        try {
+            master.start();
+            result.startup_wall_seconds = wall.elapsed_s();
+            while (master.advance(end_ns)) {
+                if (wall.elapsed_s() > spec.timeouts.case_wall_s) {
+                    throw NodeFailure("harness", "case exceeded its wall-time bound of " +
+                                                     std::to_string(spec.timeouts.case_wall_s) + " s");
+                }
+            }
+            master.shutdown();
+            const std::string ended = controller.stop();
+            if (ended != "process exited with status 0") {
+                throw NodeFailure("controller", "after shutdown: " + ended);
+            }
+        } catch (const NodeFailure& failure) {
+            master.shutdown();
+            controller.stop(std::chrono::milliseconds(500));
+            throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
+        }
+
+        result.trace_sha256 = trace.finish();
+        result.trace_path = (case_dir / "trace.sqlite").string();
+        result.sim_seconds = ns_to_seconds(end_ns);
+        result.metrics = breakpoint_metrics(trace, plant, spec.breakpoint.along_m);
+    } catch (const std::exception& error) {
+        result.error = error.what();
+    }
+    result.wall_seconds = wall.elapsed_s();
+    const CaseVerdict verdict = judge_case(result.metrics, result.limits, spec.expect.fail);
+    result.failures = verdict.failures;
+    if (!result.error.empty()) result.failures.insert(result.failures.begin(), "error: " + result.error);
+    result.expected_failure = verdict.expected_failure;
+    result.passed = result.error.empty() && verdict.passed;
+    return result;
+}
+
+std::vector<CaseResult> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options,
+                                  std::ostream& progress) {
+    std::vector<CaseResult> results(specs.size());
+    std::atomic<std::size_t> next{0};
+    std::mutex progress_mutex;
+    auto worker = [&] {
+        for (std::size_t i = next++; i < specs.size(); i = next++) {
+            results[i] = run_case(specs[i], options);
+            std::lock_guard lock(progress_mutex);
+            progress << "rig: [" << (results[i].passed ? "PASS" : "FAIL") << "] " << results[i].name << " ("
+                     << results[i].wall_seconds << " s wall)\n";
+        }
+    };
+    const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(specs.size())));
+    std::vector<std::thread> threads;
+    for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
+    for (auto& thread : threads) thread.join();
+    return results;
+}
+
+}  // namespace rig::harness

@@ -1,0 +1,35 @@
+#pragma once
+// Runs cases: builds the plant and emulators from the case file, starts the
+// controller under test as its own process, drives everything in lockstep,
+// records the trace, computes metrics from truth and judges them.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <vector>
+
+#include "harness/case_spec.h"
+#include "harness/results_writer.h"
+
+namespace rig::harness {
+
+struct RunOptions {
+    std::filesystem::path out_dir = "rig-out";
+    std::optional<std::uint64_t> seed_override;
+    int jobs = 1;
+    // Default controller when a case names no command: the reference controller.
+    std::filesystem::path controller_executable = "rig-controller";
+};
+
+// Checks that need more than the file itself (e.g. the reference controller's
+// own parameters); throws rig::ConfigError naming file, line and key.
+void validate_for_run(const CaseSpec& spec, const RunOptions& options);
+
+// Runs one case to the end (or to the first failure); never throws.
+CaseResult run_case(const CaseSpec& spec, const RunOptions& options);
+
+// Runs cases `options.jobs` at a time, printing one progress line per case.
+std::vector<CaseResult> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options,
+                                  std::ostream& progress);
+
+}  // namespace rig::harness

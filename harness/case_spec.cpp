@@ -1,0 +1,370 @@
+#include "harness/case_spec.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <optional>
+#include <system_error>
+
+namespace rig::harness {
+
+namespace {
+
+constexpr EnumChoice<RunMode> kRunModes[] = {
+    {"lockstep", RunMode::lockstep},
+    {"realtime", RunMode::realtime},
+};
+constexpr EnumChoice<GnssTalker> kTalkers[] = {
+    {"GP", GnssTalker::gp},
+    {"GN", GnssTalker::gn},
+    {"BD", GnssTalker::bd},
+    {"GB", GnssTalker::gb},
+};
+constexpr EnumChoice<GnssFix> kFixes[] = {
+    {"rtk_fixed", GnssFix::rtk_fixed},
+    {"rtk_float", GnssFix::rtk_float},
+    {"dgps", GnssFix::dgps},
+    {"autonomous", GnssFix::autonomous},
+};
+
+template <class E, std::size_t N>
+std::string_view name_of(const EnumChoice<E> (&choices)[N], E value) {
+    for (const EnumChoice<E>& choice : choices) {
+        if (choice.value == value) return choice.name;
+    }
+    return "?";
+}
+
+// Shortest text that reads back as the same double ("-60", not "-60.000000").
+std::string number_text(double value) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+    return std::string(buffer, result.ptr);
+}
+
+bool is_case_name(std::string_view name) {
+    return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '_' || c == '-';
+    });
+}
+
+// Fixed-width digits at text[pos, pos + count), or nullopt.
+std::optional<int> digits_at(std::string_view text, std::size_t pos, std::size_t count) {
+    if (pos + count > text.size()) return std::nullopt;
+    int value = 0;
+    const char* begin = text.data() + pos;
+    const auto result = std::from_chars(begin, begin + count, value);
+    if (result.ec != std::errc{} || result.ptr != begin + count || !std::isdigit(static_cast<unsigned char>(*begin))) {
+        return std::nullopt;
+    }
+    return value;
+}
+
+// ISO-8601 UTC, `YYYY-MM-DDTHH:MM:SS[.fraction]Z`. The Z is required so that a
+// case never depends on the time zone of the machine running it.
+std::optional<std::chrono::sys_time<std::chrono::nanoseconds>> parse_utc(std::string_view text) {
+    using namespace std::chrono;
+    const auto year_value = digits_at(text, 0, 4);
+    const auto month_value = digits_at(text, 5, 2);
+    const auto day_value = digits_at(text, 8, 2);
+    const auto hour_value = digits_at(text, 11, 2);
+    const auto minute_value = digits_at(text, 14, 2);
+    const auto second_value = digits_at(text, 17, 2);
+    if (!year_value || !month_value || !day_value || !hour_value || !minute_value || !second_value) return std::nullopt;
+    if (text[4] != '-' || text[7] != '-' || text[10] != 'T' || text[13] != ':' || text[16] != ':') return std::nullopt;
+    if (text.back() != 'Z') return std::nullopt;
+    const year_month_day date{year{*year_value}, month{static_cast<unsigned>(*month_value)},
+                              day{static_cast<unsigned>(*day_value)}};
+    if (!date.ok() || *hour_value > 23 || *minute_value > 59 || *second_value > 59) return std::nullopt;
+
+    std::int64_t fraction_ns = 0;
+    std::string_view rest = text.substr(19, text.size() - 20);  // between the seconds and the Z
+    if (!rest.empty()) {
+        if (rest.front() != '.' || rest.size() < 2 || rest.size() > 10) return std::nullopt;
+        std::int64_t scale = 100'000'000;
+        for (const char c : rest.substr(1)) {
+            if (!std::isdigit(static_cast<unsigned char>(c))) return std::nullopt;
+            fraction_ns += (c - '0') * scale;
+            scale /= 10;
+        }
+    }
+    return sys_days{date} + hours{*hour_value} + minutes{*minute_value} + seconds{*second_value} +
+           nanoseconds{fraction_ns};
+}
+
+// ---------------------------------------------------------------- sections
+
+FieldSpec read_field(const YamlSection& section) {
+    FieldSpec field;
+    const YamlSection origin = section.required_section("origin");
+    field.origin.lat_deg = origin.required_in_range<double>("lat_deg", Bounds::closed(-85, 85));
+    field.origin.lon_deg = origin.required_in_range<double>("lon_deg", Bounds::closed(-180, 180));
+    field.origin.height_m = origin.optional_in_range<double>("height_m", 0.0, Bounds::closed(-1000, 10000));
+    field.heading_deg = section.required_in_range<double>("heading_deg", Bounds::closed_open(0, 360));
+    return field;
+}
+
+VehicleSpec read_vehicle(const YamlSection& section) {
+    VehicleSpec vehicle;
+    vehicle.speed_km_h = section.required_in_range<double>("speed_km_h", Bounds::open_closed(0, 30));
+    vehicle.accel_m_s2 = section.optional_in_range<double>("accel_m_s2", vehicle.accel_m_s2, Bounds::open_closed(0, 5));
+    vehicle.start_m = section.required<double>("start_m");
+    vehicle.overrun_m = section.optional_in_range<double>("overrun_m", vehicle.overrun_m, Bounds::at_least(0));
+    return vehicle;
+}
+
+BoomSpec read_boom(const YamlSection& section) {
+    BoomSpec boom;
+    boom.l1_m = section.optional_in_range<double>("l1_m", boom.l1_m, Bounds::at_least(0));
+    boom.l2_m = section.optional_in_range<double>("l2_m", boom.l2_m, Bounds::at_least(0));
+    boom.l3_m = section.optional_in_range<double>("l3_m", boom.l3_m, Bounds::at_least(0));
+    boom.linkage_rise_m = section.optional_in_range<double>("linkage_rise_m", boom.linkage_rise_m, Bounds::at_least(0));
+    return boom;
+}
+
+BreakpointSpec read_breakpoint(const YamlSection& section) {
+    BreakpointSpec breakpoint;
+    breakpoint.along_m = section.optional<double>("along_m", breakpoint.along_m);
+    breakpoint.button_at_s =
+        section.optional_in_range<double>("button_at_s", breakpoint.button_at_s, Bounds::greater_than(0));
+    return breakpoint;
+}
+
+GnssSpec read_gnss(const YamlSection& section) {
+    GnssSpec gnss;
+    gnss.talker = section.optional_enum<GnssTalker>("talker", kTalkers, gnss.talker);
+    gnss.rate_hz = section.optional_in_range<double>("rate_hz", gnss.rate_hz, Bounds::open_closed(0, 20));
+    gnss.latency_s = section.optional_in_range<double>("latency_s", gnss.latency_s, Bounds::closed_open(0, 1));
+    gnss.fix = section.optional_enum<GnssFix>("fix", kFixes, gnss.fix);
+
+    const YamlSection noise = section.section("noise");
+    gnss.noise.base_m = noise.optional_in_range<double>("base_m", gnss.noise.base_m, Bounds::at_least(0));
+    gnss.noise.ppm = noise.optional_in_range<double>("ppm", gnss.noise.ppm, Bounds::at_least(0));
+    gnss.noise.baseline_km = noise.optional_in_range<double>("baseline_km", gnss.noise.baseline_km, Bounds::at_least(0));
+
+    for (const YamlSection& item : section.list("dropouts")) {
+        GnssDropout dropout;
+        if (item.has("before_breakpoint_s")) {
+            if (item.has("at_s")) item.fail("at_s", "give either at_s or before_breakpoint_s, not both");
+            dropout.before_breakpoint_s = item.required_in_range<double>("before_breakpoint_s", Bounds::at_least(0));
+        } else {
+            dropout.at_s = item.required_in_range<double>("at_s", Bounds::at_least(0));
+        }
+        dropout.for_s = item.required_in_range<double>("for_s", Bounds::greater_than(0));
+        gnss.dropouts.push_back(dropout);
+    }
+    for (const YamlSection& item : section.list("degraded")) {
+        GnssDegraded degraded;
+        degraded.at_s = item.required_in_range<double>("at_s", Bounds::at_least(0));
+        degraded.for_s = item.required_in_range<double>("for_s", Bounds::greater_than(0));
+        degraded.fix = item.optional_enum<GnssFix>("fix", kFixes, degraded.fix);
+        degraded.sigma_m = item.required_in_range<double>("sigma_m", Bounds::at_least(0));
+        gnss.degraded.push_back(degraded);
+    }
+    return gnss;
+}
+
+EncoderSpec read_encoder(const YamlSection& section) {
+    EncoderSpec encoder;
+    encoder.pulses_per_rev =
+        section.optional_in_range<std::uint32_t>("pulses_per_rev", encoder.pulses_per_rev, Bounds::greater_than(0));
+    encoder.wheel_diameter_m =
+        section.optional_in_range<double>("wheel_diameter_m", encoder.wheel_diameter_m, Bounds::greater_than(0));
+    encoder.rate_hz = section.optional_in_range<double>("rate_hz", encoder.rate_hz, Bounds::open_closed(0, 1000));
+    encoder.slip_pct = section.optional_in_range<double>("slip_pct", encoder.slip_pct, Bounds::closed(-20, 20));
+    encoder.slip_sd_pct = section.optional_in_range<double>("slip_sd_pct", encoder.slip_sd_pct, Bounds::at_least(0));
+    return encoder;
+}
+
+// The section stays raw for the controller; only `command` is the rig's. It is
+// read through a separate YamlSection (never finish()ed) so the controller's
+// own keys are not reported as unknown here.
+ControllerSpec read_controller(const YamlSection& root) {
+    ControllerSpec controller;
+    controller.params = root.raw("controller");
+    if (controller.params.present && !controller.params.node.IsNull() && !controller.params.node.IsMap()) {
+        root.fail("controller", "expected a mapping (key: value), got " + describe_node(controller.params.node));
+    }
+    const YamlSection section(controller.params);
+    if (section.has("command")) {
+        controller.command = section.string_list("command");
+        if (controller.command.empty()) {
+            section.fail("command", "must name the controller executable, e.g. [ \"rig-controller\" ]");
+        }
+    }
+    return controller;
+}
+
+std::map<std::string, double> read_limits(const YamlSection& section) {
+    std::map<std::string, double> limits;
+    for (const std::string& name : section.keys()) {
+        if (const std::string problem = metric_name_problem(name); !problem.empty()) {
+            throw ConfigError(section.key_location(name), problem);
+        }
+        limits[name] = section.required<double>(name);
+    }
+    return limits;
+}
+
+ExpectSpec read_expect(const YamlSection& section) {
+    ExpectSpec expect;
+    expect.fail = section.string_list("fail");
+    return expect;
+}
+
+TimeoutsSpec read_timeouts(const YamlSection& section) {
+    TimeoutsSpec timeouts;
+    timeouts.node_ack_s =
+        section.optional_in_range<double>("node_ack_s", timeouts.node_ack_s, Bounds::open_closed(0, 600));
+    timeouts.case_wall_s =
+        section.optional_in_range<double>("case_wall_s", timeouts.case_wall_s, Bounds::open_closed(0, 86400));
+    return timeouts;
+}
+
+// Checks between sections; run after finish(), when every value is real.
+void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
+                        const std::map<std::string, double>& default_limits) {
+    if (!(spec.vehicle.start_m < spec.breakpoint.along_m)) {
+        root.section("vehicle").fail("start_m", "must be < breakpoint.along_m (" +
+                                                    number_text(spec.breakpoint.along_m) +
+                                                    ") so the vehicle approaches the breakpoint, got " +
+                                                    number_text(spec.vehicle.start_m));
+    }
+    const YamlSection expect = root.section("expect");
+    for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
+        const std::string& metric = spec.expect.fail[index];
+        if (!spec.limits.contains(metric) && !default_limits.contains(metric)) {
+            throw ConfigError(expect.item_location("fail", index),
+                              "'" + metric + "' has no limit; expected failures must name limited metrics "
+                              "(limits in this file or the defaults)");
+        }
+        for (std::size_t earlier = 0; earlier < index; ++earlier) {
+            if (spec.expect.fail[earlier] == metric) {
+                throw ConfigError(expect.item_location("fail", index), "'" + metric + "' is listed twice");
+            }
+        }
+    }
+}
+
+}  // namespace
+
+std::string_view to_string(RunMode mode) { return name_of(kRunModes, mode); }
+std::string_view to_string(GnssTalker talker) { return name_of(kTalkers, talker); }
+std::string_view to_string(GnssFix fix) { return name_of(kFixes, fix); }
+
+std::string metric_name_problem(std::string_view name) {
+    const auto fail = [&](const std::string& why) {
+        std::string suffixes;
+        for (const std::string_view suffix : kMetricUnitSuffixes) {
+            if (!suffixes.empty()) suffixes += ", ";
+            suffixes += '_';
+            suffixes += suffix;
+        }
+        return "metric name '" + std::string(name) + "' " + why +
+               "; metric names are snake_case with a unit suffix (" + suffixes + ")";
+    };
+    bool snake_case = !name.empty() && std::islower(static_cast<unsigned char>(name.front())) != 0 &&
+                      name.back() != '_' && name.find("__") == std::string_view::npos;
+    for (const char c : name) {
+        const auto byte = static_cast<unsigned char>(c);
+        if (!(std::islower(byte) || std::isdigit(byte) || c == '_')) snake_case = false;
+    }
+    if (!snake_case) return fail("is not snake_case");
+    for (const std::string_view suffix : kMetricUnitSuffixes) {
+        // At least one word before `_<suffix>`.
+        if (name.size() > suffix.size() + 1 && name.ends_with(suffix) && name[name.size() - suffix.size() - 1] == '_') {
+            return {};
+        }
+    }
+    return fail("has no unit suffix");
+}
+
+std::map<std::string, double> effective_limits(const CaseSpec& spec, const std::map<std::string, double>& defaults) {
+    std::map<std::string, double> limits = defaults;
+    for (const auto& [name, limit] : spec.limits) limits[name] = limit;
+    return limits;
+}
+
+namespace {
+
+CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_path,
+                   const std::map<std::string, double>& default_limits) {
+    CaseSpec spec;
+    spec.source_path = source_path;
+
+    spec.name = root.required<std::string>("name");
+    if (root.has("name") && !is_case_name(spec.name)) {
+        root.fail("name", "must be letters, digits, '.', '_' or '-' (it names output files), got '" + spec.name + "'");
+    }
+    spec.description = root.optional<std::string>("description", "");
+    spec.seed = root.optional<std::uint64_t>("seed", spec.seed);
+    spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
+    spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);
+    const auto utc_start = parse_utc(spec.utc_start_iso);
+    if (!utc_start) {
+        root.fail("utc_start", "expected an ISO-8601 UTC time like 2023-07-15T02:00:00Z, got '" +
+                                   spec.utc_start_iso + "'");
+    }
+    spec.utc_start = *utc_start;
+
+    spec.field = read_field(root.required_section("field"));
+    spec.vehicle = read_vehicle(root.required_section("vehicle"));
+    spec.boom = read_boom(root.section("boom"));
+    spec.breakpoint = read_breakpoint(root.section("breakpoint"));
+    spec.gnss = read_gnss(root.section("gnss"));
+    spec.encoder = read_encoder(root.section("encoder"));
+    spec.controller = read_controller(root);
+    spec.limits = read_limits(root.section("limits"));
+    spec.expect = read_expect(root.section("expect"));
+    spec.timeouts = read_timeouts(root.section("timeouts"));
+
+    root.finish();
+    check_cross_fields(spec, root, default_limits);
+    return spec;
+}
+
+}  // namespace
+
+CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name,
+                    const std::map<std::string, double>& default_limits) {
+    return read_case(YamlSection::load_string(yaml_text, file_name.string()), file_name, default_limits);
+}
+
+CaseSpec load_case_file(const std::filesystem::path& path, const std::map<std::string, double>& default_limits) {
+    return read_case(YamlSection::load_file(path), path, default_limits);
+}
+
+std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args) {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> paths;
+    for (const std::string& arg : args) {
+        const fs::path path(arg);
+        std::error_code error;
+        const fs::file_status status = fs::status(path, error);
+        if (status.type() == fs::file_type::not_found) {
+            throw ConfigError(SourceLocation{arg, 0, 0, "(file)"}, "no such case file or directory");
+        }
+        if (error) throw ConfigError(SourceLocation{arg, 0, 0, "(file)"}, "cannot access: " + error.message());
+        if (status.type() != fs::file_type::directory) {
+            paths.push_back(path);
+            continue;
+        }
+        std::vector<fs::path> cases;
+        for (const fs::directory_entry& entry : fs::directory_iterator(path)) {
+            const std::string file_name = entry.path().filename().string();
+            const std::string extension = entry.path().extension().string();
+            if (file_name.starts_with('.') || (extension != ".yaml" && extension != ".yml")) continue;
+            if (!entry.is_regular_file()) continue;
+            cases.push_back(entry.path());
+        }
+        if (cases.empty()) {
+            throw ConfigError(SourceLocation{arg, 0, 0, "(file)"}, "directory has no *.yaml or *.yml case files");
+        }
+        std::sort(cases.begin(), cases.end(),
+                  [](const fs::path& a, const fs::path& b) { return a.filename().string() < b.filename().string(); });
+        paths.insert(paths.end(), cases.begin(), cases.end());
+    }
+    return paths;
+}
+
+}  // namespace rig::harness

@@ -1,0 +1,193 @@
+#pragma once
+// A case file (DESIGN.md "Case files") as plain structs, and its strict loader.
+// Every mistake in a case file is a rig::ConfigError at `file:line:col: key: message`,
+// raised before anything starts.
+//
+// Member names carry their unit, like the YAML keys they come from. Values not
+// given in the file take the defaults written here (from Li et al. 2023,
+// Agriculture 13, 2203, where the paper has a number).
+//
+// Adding a section (hydraulics, flow meters, valves...) is one struct here, one
+// `read_...(const YamlSection&)` function in case_spec.cpp, and one line in
+// parse_case() that calls it; cross-field checks go in check_cross_fields().
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rig/config_error.h"
+#include "rig/yaml_fields.h"
+
+namespace rig::harness {
+
+enum class RunMode { lockstep, realtime };
+// NMEA talker id of the emulated receiver: GPS, multi-constellation, BeiDou (two spellings).
+enum class GnssTalker { gp, gn, bd, gb };
+enum class GnssFix { rtk_fixed, rtk_float, dgps, autonomous };
+
+// The spelling used in case files ("lockstep", "GP", "rtk_fixed").
+std::string_view to_string(RunMode mode);
+std::string_view to_string(GnssTalker talker);
+std::string_view to_string(GnssFix fix);
+
+struct GeoOrigin {
+    double lat_deg = 0.0;  // required, [-85, 85]
+    double lon_deg = 0.0;  // required, [-180, 180]
+    double height_m = 0.0;
+};
+
+struct FieldSpec {
+    GeoOrigin origin;          // required
+    double heading_deg = 0.0;  // required: A-B line direction, 0 = north, clockwise, [0, 360)
+};
+
+struct VehicleSpec {
+    double speed_km_h = 0.0;  // required cruise speed, (0, 30]
+    double accel_m_s2 = 0.5;  // (0, 5]
+    double start_m = 0.0;     // required: nozzle line along the A-B line at approach start, < breakpoint.along_m
+    double overrun_m = 5.0;   // driven past the breakpoint before the case ends, >= 0
+};
+
+// Antenna-to-nozzle geometry of Eq. 6: L4 = L1 + cos(atan(h/L2))*L2 + L3, 1.63 m with these values.
+struct BoomSpec {
+    double l1_m = 0.50;
+    double l2_m = 0.80;
+    double l3_m = 0.45;
+    double linkage_rise_m = 0.50;  // h in Eq. 6
+};
+
+struct BreakpointSpec {
+    double along_m = 0.0;      // ground position of the breakpoint on the A-B line
+    double button_at_s = 1.0;  // vehicle stands with the nozzle line at along_m; button pressed then, > 0
+};
+
+struct GnssNoiseSpec {
+    double base_m = 0.008;  // RTK 8 mm + 1 ppm (paper)
+    double ppm = 1.0;
+    double baseline_km = 2.0;
+    // 1-sigma horizontal error: base + ppm * baseline.
+    double horizontal_sigma_m() const { return base_m + ppm * 1e-6 * baseline_km * 1000.0; }
+};
+
+// No sentences at all during [at_s, at_s + for_s).
+struct GnssDropout {
+    double at_s = 0.0;   // >= 0
+    // Instead of at_s: start this long before the nozzle line reaches the
+    // breakpoint on the approach (how Table 4 run 8's loss is placed).
+    std::optional<double> before_breakpoint_s;
+    double for_s = 0.0;  // > 0
+};
+
+// A worse fix during [at_s, at_s + for_s).
+struct GnssDegraded {
+    double at_s = 0.0;                    // >= 0
+    double for_s = 0.0;                   // > 0
+    GnssFix fix = GnssFix::rtk_float;
+    double sigma_m = 0.0;                 // required, >= 0: 1-sigma horizontal error while degraded
+};
+
+struct GnssSpec {
+    GnssTalker talker = GnssTalker::gp;
+    double rate_hz = 5.0;      // (0, 20]; the G970II runs at 5 Hz
+    double latency_s = 0.02;   // [0, 1): fix epoch -> sentence on the wire
+    GnssFix fix = GnssFix::rtk_fixed;
+    GnssNoiseSpec noise;
+    std::vector<GnssDropout> dropouts;  // may overlap each other; not checked
+    std::vector<GnssDegraded> degraded;
+};
+
+struct EncoderSpec {
+    std::uint32_t pulses_per_rev = 1000;  // > 0; the paper's ZSP5208 has 1000 p/r
+    double wheel_diameter_m = 1.0;        // > 0 (not given in the paper)
+    double rate_hz = 100.0;               // count publication rate, (0, 1000]
+    double slip_pct = 0.0;                // mean wheel slip, [-20, 20]; ideal wheel unless the case says so
+    double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), >= 0
+};
+
+struct ControllerSpec {
+    // argv of the controller executable; empty = the reference controller.
+    std::vector<std::string> command;
+    // The whole `controller:` section as written, with its location, for the
+    // controller to validate. It includes `command`, which belongs to the rig:
+    // a controller checking its keys must allow it (kControllerRigKeys).
+    RawYaml params;
+};
+// Keys of the controller section that the rig reads itself.
+inline constexpr std::array<std::string_view, 1> kControllerRigKeys = {"command"};
+
+struct ExpectSpec {
+    // Metrics that must break their limits (a negative case): the case passes
+    // only when exactly these fail. Each must have a limit (file or default).
+    std::vector<std::string> fail;
+};
+
+struct TimeoutsSpec {
+    double node_ack_s = 10.0;    // wall time for a node to acknowledge a tick, (0, 600]
+    double case_wall_s = 600.0;  // wall time for the whole case, (0, 86400]
+};
+
+struct CaseSpec {
+    std::filesystem::path source_path;
+    std::string name;  // required, [A-Za-z0-9._-]+
+    std::string description;
+    std::uint64_t seed = 1;  // `rig run --seed` overrides
+    RunMode mode = RunMode::lockstep;
+    std::string utc_start_iso = "2023-07-15T02:00:00Z";
+    // GNSS UTC = utc_start + simulated time.
+    std::chrono::sys_time<std::chrono::nanoseconds> utc_start;
+    FieldSpec field;
+    VehicleSpec vehicle;
+    BoomSpec boom;
+    BreakpointSpec breakpoint;
+    GnssSpec gnss;
+    EncoderSpec encoder;
+    ControllerSpec controller;
+    // Limits as written in the file (metric name -> max allowed value); the
+    // harness judges against effective_limits(), i.e. these over the defaults.
+    std::map<std::string, double> limits;
+    ExpectSpec expect;
+    TimeoutsSpec timeouts;
+};
+
+// Limits every case gets unless its file overrides them. Only metrics the
+// harness actually measures belong here (a limited metric that is not measured
+// fails the case): add flow_adjust_time_s 1.7, flow_error_pct 3, overlap_m 3.3,
+// missed_m 0 (DESIGN.md "What the harness measures") as they are implemented.
+inline const std::map<std::string, double> kDefaultLimits = {
+    {"breakpoint_error_m", 0.16},  // Table 3: fusion max 15.85 cm
+};
+
+// Unit suffixes a metric (limit) name may end with, as `_<suffix>`.
+// Names are snake_case: [a-z][a-z0-9]*(_[a-z0-9]+)*, with at least one word
+// before the unit (`overlap_m`, `flow_error_pct`, `flow_l_min`, `missed_count`).
+inline constexpr std::array<std::string_view, 24> kMetricUnitSuffixes = {
+    "m",   "cm",  "mm",  "km",    "m2",    "ha",     "s",   "ms",   "hz", "pct", "count", "l",
+    "ml",  "l_min", "l_ha", "ul_cm2", "deg", "rad", "kpa", "mpa", "v", "ma",  "km_h",  "m_s",
+};
+// Empty when `name` is a valid metric name, else why not.
+std::string metric_name_problem(std::string_view name);
+
+// The case's limits over `defaults` (the file wins).
+std::map<std::string, double> effective_limits(const CaseSpec& spec,
+                                               const std::map<std::string, double>& defaults = kDefaultLimits);
+
+// Parses and validates a case file; throws rig::ConfigError. `default_limits`
+// is what expect.fail names may refer to besides the file's own limits.
+CaseSpec load_case_file(const std::filesystem::path& path,
+                        const std::map<std::string, double>& default_limits = kDefaultLimits);
+// The same from text in memory; `file_name` is what errors call it.
+CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name,
+                    const std::map<std::string, double>& default_limits = kDefaultLimits);
+
+// Command-line case arguments to files: a file stays as given; a directory
+// becomes its `*.yaml` / `*.yml` files (not recursive, hidden files skipped),
+// sorted by file name. A missing path, or a directory with no case files, is
+// a rig::ConfigError naming it.
+std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args);
+
+}  // namespace rig::harness

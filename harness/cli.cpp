@@ -1,0 +1,98 @@
+// `rig`: the rig's one command line (DESIGN.md "Command line").
+//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
+//   rig nmea decode FILE|-
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+#include <iostream>
+#include <unistd.h>
+
+#include "controller/nmea_decode_tool.h"
+#include "harness/case_runner.h"
+#include "harness/results_writer.h"
+#include "rig/clock.h"
+#include "rig/config_error.h"
+
+namespace {
+
+std::filesystem::path own_directory() {
+    std::error_code error;
+    const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
+    return error ? std::filesystem::current_path() : self.parent_path();
+}
+
+int run_command(const std::vector<std::string>& inputs, const rig::harness::RunOptions& options) {
+    using namespace rig::harness;
+    std::vector<CaseSpec> specs;
+    try {
+        // Every file is read and validated before anything starts.
+        std::vector<std::string> errors;
+        for (const auto& path : expand_case_paths(inputs)) {
+            try {
+                specs.push_back(load_case_file(path));
+                validate_for_run(specs.back(), options);
+            } catch (const std::exception& error) {
+                errors.push_back(error.what());
+            }
+        }
+        if (!errors.empty()) {
+            for (const auto& error : errors) std::cerr << "rig: " << error << "\n";
+            std::cerr << "rig: " << errors.size() << " case file error(s); nothing was run\n";
+            return 2;
+        }
+    } catch (const std::exception& error) {
+        std::cerr << "rig: " << error.what() << "\n";
+        return 2;
+    }
+    const rig::WallStopwatch wall;
+    const auto results = run_cases(specs, options, std::cerr);
+    RunSummary summary = summarize(results);
+    summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
+    write_results(options.out_dir, results, summary);
+    std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
+              << (options.out_dir / "report.txt").string() << "\n";
+    return summary.failed == 0 ? 0 : 1;
+}
+
+int nmea_decode_command(const std::string& input) {
+    if (input == "-") return rig::nmea::decode_stream(std::cin, std::cout);
+    std::ifstream file(input, std::ios::binary);
+    if (!file) {
+        std::cerr << "rig nmea decode: cannot open " << input << "\n";
+        return 2;
+    }
+    return rig::nmea::decode_stream(file, std::cout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Sprayer HIL rig: runs timed cases against a controller under test and judges them from truth"};
+    app.require_subcommand(1);
+
+    rig::harness::RunOptions run_options;
+    run_options.controller_executable = own_directory() / "rig-controller";
+    std::vector<std::string> case_inputs;
+    std::uint64_t seed = 0;
+    auto* run = app.add_subcommand("run", "run case files (or directories of them) and judge them");
+    run->add_option("cases", case_inputs, "case files or directories")->required();
+    run->add_option("--out", run_options.out_dir, "output directory (results.json, junit.xml, report, traces)");
+    auto* seed_option = run->add_option("--seed", seed, "override every case's seed");
+    run->add_option("--jobs", run_options.jobs, "cases run at once, each on its own DDS domain")
+        ->check(CLI::Range(1, 16));
+
+    auto* nmea = app.add_subcommand("nmea", "NMEA tools");
+    nmea->require_subcommand(1);
+    std::string nmea_input;
+    auto* decode = nmea->add_subcommand("decode", "decode NMEA lines with the controller's parser, one JSON per line");
+    decode->add_option("input", nmea_input, "file, or - for standard input")->required();
+
+    CLI11_PARSE(app, argc, argv);
+    if (run->parsed()) {
+        if (seed_option->count() > 0) run_options.seed_override = seed;
+        return run_command(case_inputs, run_options);
+    }
+    if (decode->parsed()) return nmea_decode_command(nmea_input);
+    return 2;
+}

@@ -1,0 +1,510 @@
+#include "harness/results_writer.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+
+namespace rig::harness {
+
+namespace {
+
+constexpr std::string_view kMissingSuffix = " missing";
+
+std::string format_g(double value, int significant_digits) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*g", significant_digits, value);
+    return buffer;
+}
+
+// `value` with at least `min_digits` significant digits, and more when needed
+// so that it does not print the same as a different `reference` (a value of
+// 3.3000001 against a limit of 3.3 must not read "3.3 > 3.3").
+std::string format_against(double value, double reference, int min_digits) {
+    for (int digits = min_digits; digits < 17; ++digits) {
+        const std::string text = format_g(value, digits);
+        if (value == reference || text != format_g(reference, digits)) return text;
+    }
+    return format_g(value, 17);
+}
+
+std::string format_fixed(double value, int decimals) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, std::isfinite(value) ? value : 0.0);
+    return buffer;
+}
+
+// The metric a judge() failure is about: the text before its first space.
+std::string failure_metric(const std::string& failure) { return failure.substr(0, failure.find(' ')); }
+
+bool is_missing_failure(const std::string& failure) { return failure.ends_with(kMissingSuffix); }
+
+std::string status_word(const CaseResult& result) {
+    if (!case_passed(result)) return "FAIL";
+    return result.expected_failure ? "XFAIL-OK" : "PASS";
+}
+
+// ---------------------------------------------------------------- XML text
+
+// Appends the code point as UTF-8.
+void append_utf8(std::string& out, char32_t code_point) {
+    if (code_point < 0x80) {
+        out += static_cast<char>(code_point);
+    } else if (code_point < 0x800) {
+        out += static_cast<char>(0xC0 | (code_point >> 6));
+        out += static_cast<char>(0x80 | (code_point & 0x3F));
+    } else if (code_point < 0x10000) {
+        out += static_cast<char>(0xE0 | (code_point >> 12));
+        out += static_cast<char>(0x80 | ((code_point >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (code_point & 0x3F));
+    } else {
+        out += static_cast<char>(0xF0 | (code_point >> 18));
+        out += static_cast<char>(0x80 | ((code_point >> 12) & 0x3F));
+        out += static_cast<char>(0x80 | ((code_point >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (code_point & 0x3F));
+    }
+}
+
+constexpr char32_t kReplacementCharacter = 0xFFFD;
+
+// Decodes one UTF-8 sequence at text[pos]; advances pos. Malformed input
+// (bad lead byte, truncated, overlong, surrogate, > U+10FFFF) gives U+FFFD and
+// consumes one byte, so error text from a crashed child never breaks the XML.
+char32_t next_code_point(std::string_view text, std::size_t& pos) {
+    const auto lead = static_cast<unsigned char>(text[pos]);
+    std::size_t length = 0;
+    char32_t code_point = 0;
+    char32_t minimum = 0;
+    if (lead < 0x80) {
+        ++pos;
+        return lead;
+    } else if ((lead & 0xE0) == 0xC0) {
+        length = 2;
+        code_point = lead & 0x1Fu;
+        minimum = 0x80;
+    } else if ((lead & 0xF0) == 0xE0) {
+        length = 3;
+        code_point = lead & 0x0Fu;
+        minimum = 0x800;
+    } else if ((lead & 0xF8) == 0xF0) {
+        length = 4;
+        code_point = lead & 0x07u;
+        minimum = 0x10000;
+    } else {
+        ++pos;
+        return kReplacementCharacter;
+    }
+    if (pos + length > text.size()) {
+        ++pos;
+        return kReplacementCharacter;
+    }
+    for (std::size_t i = 1; i < length; ++i) {
+        const auto continuation = static_cast<unsigned char>(text[pos + i]);
+        if ((continuation & 0xC0) != 0x80) {
+            ++pos;
+            return kReplacementCharacter;
+        }
+        code_point = (code_point << 6) | (continuation & 0x3Fu);
+    }
+    if (code_point < minimum || code_point > 0x10FFFF || (code_point >= 0xD800 && code_point <= 0xDFFF)) {
+        ++pos;
+        return kReplacementCharacter;
+    }
+    pos += length;
+    return code_point;
+}
+
+bool allowed_in_xml(char32_t c) {
+    return c == 0x9 || c == 0xA || c == 0xD || (c >= 0x20 && c <= 0xD7FF) || (c >= 0xE000 && c <= 0xFFFD) ||
+           (c >= 0x10000 && c <= 0x10FFFF);
+}
+
+// The text with malformed UTF-8 replaced by U+FFFD (nlohmann::json refuses to
+// dump invalid UTF-8, and error text may come from a crashed child's output).
+std::string valid_utf8(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    std::size_t pos = 0;
+    while (pos < text.size()) append_utf8(out, next_code_point(text, pos));
+    return out;
+}
+
+// Escapes for element text, or for a double-quoted attribute value (where
+// line breaks and tabs are written as character references so they survive
+// attribute-value normalisation).
+std::string xml_escape(std::string_view text, bool attribute) {
+    std::string out;
+    out.reserve(text.size() + 16);
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        char32_t c = next_code_point(text, pos);
+        if (!allowed_in_xml(c)) c = kReplacementCharacter;
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += attribute ? "&quot;" : "\""; break;
+            case '\'': out += attribute ? "&apos;" : "'"; break;
+            case '\r': out += "&#13;"; break;
+            case '\n': out += attribute ? "&#10;" : "\n"; break;
+            case '\t': out += attribute ? "&#9;" : "\t"; break;
+            default: append_utf8(out, c);
+        }
+    }
+    return out;
+}
+
+std::string join_lines(const std::vector<std::string>& lines) {
+    std::string text;
+    for (const std::string& line : lines) {
+        text += line;
+        text += '\n';
+    }
+    return text;
+}
+
+// Metrics, each with its limit when it has one: "name value / limit" or "name value".
+std::string metrics_text(const CaseResult& result) {
+    std::string text;
+    for (const auto& [name, value] : result.metrics) {
+        text += name + ' ' + format_g(value, 6);
+        if (const auto limit = result.limits.find(name); limit != result.limits.end()) {
+            text += " (limit " + format_g(limit->second, 6) + ')';
+        }
+        text += '\n';
+    }
+    return text;
+}
+
+// ---------------------------------------------------------------- table
+
+// Display width of UTF-8 text, counting code points (case names are ASCII; this
+// only keeps a stray accented character from skewing the columns).
+std::size_t display_width(std::string_view text) {
+    std::size_t width = 0;
+    for (const char c : text) {
+        if ((static_cast<unsigned char>(c) & 0xC0) != 0x80) ++width;
+    }
+    return width;
+}
+
+std::string pad_right(const std::string& text, std::size_t width) {
+    const std::size_t current = display_width(text);
+    return current >= width ? text : text + std::string(width - current, ' ');
+}
+
+struct TableRow {
+    std::string name;
+    std::string status;
+    std::vector<std::string> metric_lines;
+    std::vector<std::string> failure_lines;
+};
+
+TableRow make_row(const CaseResult& result, std::size_t metric_name_width) {
+    TableRow row{result.name, status_word(result), {}, {}};
+    for (const auto& [name, limit] : result.limits) {
+        const auto metric = result.metrics.find(name);
+        const std::string value = metric == result.metrics.end() || std::isnan(metric->second)
+                                      ? std::string("-")
+                                      : format_against(metric->second, limit, 4);
+        row.metric_lines.push_back(pad_right(name, metric_name_width) + ' ' + value + " / " + format_g(limit, 6));
+    }
+    if (!result.error.empty()) row.failure_lines.push_back("error: " + result.error);
+    const bool expected = case_passed(result) && result.expected_failure;
+    for (const std::string& failure : result.failures) {
+        row.failure_lines.push_back(expected ? failure + " (expected)" : failure);
+    }
+    return row;
+}
+
+const char* status_color(const std::string& status) {
+    if (status == "PASS") return "\033[32m";
+    if (status == "XFAIL-OK") return "\033[33m";
+    return "\033[1;31m";
+}
+constexpr const char* kColorFailure = "\033[31m";
+constexpr const char* kColorReset = "\033[0m";
+
+// ---------------------------------------------------------------- files
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
+    // The temporary lives beside the target (same file system, so rename is
+    // atomic) and carries the pid so concurrent runs never share one.
+    std::filesystem::path temporary = path;
+    temporary.replace_filename("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()));
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            throw std::runtime_error("cannot create " + temporary.string() + ": " + std::strerror(errno));
+        }
+        out.write(content.data(), static_cast<std::streamsize>(content.size()));
+        out.flush();
+        if (!out) {
+            const std::string reason = std::strerror(errno);
+            std::error_code ignored;
+            std::filesystem::remove(temporary, ignored);
+            throw std::runtime_error("cannot write " + temporary.string() + ": " + reason);
+        }
+    }
+    std::error_code rename_error;
+    std::filesystem::rename(temporary, path, rename_error);
+    if (rename_error) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        throw std::filesystem::filesystem_error("cannot move results into place", temporary, path, rename_error);
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- judging
+
+std::vector<std::string> judge(const std::map<std::string, double>& metrics,
+                               const std::map<std::string, double>& limits) {
+    std::vector<std::string> failures;
+    for (const auto& [name, limit] : limits) {
+        const auto metric = metrics.find(name);
+        if (metric == metrics.end() || std::isnan(metric->second)) {
+            failures.push_back(name + std::string(kMissingSuffix));
+        } else if (std::isnan(limit)) {
+            // Case files cannot say this; a harness bug must not pass silently.
+            failures.push_back(name + ' ' + format_g(metric->second, 6) + " > nan (limit is not a number)");
+        } else if (metric->second > limit) {
+            failures.push_back(name + ' ' + format_against(metric->second, limit, 6) + " > " +
+                               format_against(limit, metric->second, 6));
+        }
+    }
+    return failures;
+}
+
+bool passes_with_expectation(const std::vector<std::string>& failures, const std::vector<std::string>& expect_fail) {
+    return unmet_expectations(failures, expect_fail).empty();
+}
+
+std::vector<std::string> unmet_expectations(const std::vector<std::string>& failures,
+                                            const std::vector<std::string>& expect_fail) {
+    if (expect_fail.empty()) return failures;
+    const std::set<std::string> expected(expect_fail.begin(), expect_fail.end());
+    std::set<std::string> broken;
+    std::vector<std::string> reasons;
+    for (const std::string& failure : failures) {
+        const std::string metric = failure_metric(failure);
+        if (expected.contains(metric) && !is_missing_failure(failure)) {
+            broken.insert(metric);
+        } else {
+            reasons.push_back(failure + (expected.contains(metric) ? " (expected a limit break)" : " (not expected)"));
+        }
+    }
+    for (const std::string& metric : expected) {
+        if (broken.contains(metric)) continue;
+        const bool missing = std::any_of(failures.begin(), failures.end(), [&](const std::string& failure) {
+            return failure_metric(failure) == metric;
+        });
+        if (!missing) reasons.push_back("expected " + metric + " to break its limit, but it held");
+    }
+    return reasons;
+}
+
+CaseVerdict judge_case(const std::map<std::string, double>& metrics, const std::map<std::string, double>& limits,
+                       const std::vector<std::string>& expect_fail) {
+    CaseVerdict verdict;
+    verdict.expected_failure = !expect_fail.empty();
+    verdict.failures = judge(metrics, limits);
+    verdict.passed = passes_with_expectation(verdict.failures, expect_fail);
+    if (verdict.expected_failure && !verdict.passed) {
+        // The limit breaks alone would not say why a negative case failed.
+        for (std::string& reason : unmet_expectations(verdict.failures, expect_fail)) {
+            if (reason.starts_with("expected ")) verdict.failures.push_back(std::move(reason));
+        }
+    }
+    return verdict;
+}
+
+bool case_passed(const CaseResult& result) { return result.passed && result.error.empty(); }
+
+RunSummary summarize(const std::vector<CaseResult>& results) {
+    RunSummary summary;
+    for (const CaseResult& result : results) {
+        if (case_passed(result)) {
+            ++summary.passed;
+        } else {
+            ++summary.failed;
+        }
+        summary.sim_seconds += result.sim_seconds;
+        summary.wall_seconds += result.wall_seconds;
+    }
+    return summary;
+}
+
+// ---------------------------------------------------------------- outputs
+
+nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary) {
+    nlohmann::json cases = nlohmann::json::array();
+    for (const CaseResult& result : results) {
+        nlohmann::json metrics = nlohmann::json::object();
+        for (const auto& [name, value] : result.metrics) metrics[valid_utf8(name)] = value;  // NaN dumps as null
+        nlohmann::json limits = nlohmann::json::object();
+        for (const auto& [name, value] : result.limits) limits[valid_utf8(name)] = value;
+        nlohmann::json failures = nlohmann::json::array();
+        for (const std::string& failure : result.failures) failures.push_back(valid_utf8(failure));
+        cases.push_back({
+            {"name", valid_utf8(result.name)},
+            {"file", valid_utf8(result.file)},
+            {"passed", case_passed(result)},
+            {"expected_failure", result.expected_failure},
+            {"seed", result.seed},
+            {"metrics", std::move(metrics)},
+            {"limits", std::move(limits)},
+            {"failures", std::move(failures)},
+            {"error", result.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(valid_utf8(result.error))},
+            {"trace_sha256", valid_utf8(result.trace_sha256)},
+            {"trace_path", valid_utf8(result.trace_path)},
+            {"sim_seconds", result.sim_seconds},
+            {"wall_seconds", result.wall_seconds},
+            {"startup_wall_seconds", result.startup_wall_seconds},
+        });
+    }
+    return {
+        {"cases", std::move(cases)},
+        {"summary",
+         {
+             {"passed", summary.passed},
+             {"failed", summary.failed},
+             {"total", summary.passed + summary.failed},
+             {"sim_seconds", summary.sim_seconds},
+             {"wall_seconds", summary.wall_seconds},
+         }},
+    };
+}
+
+std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& summary) {
+    int failures = 0;
+    int errors = 0;
+    for (const CaseResult& result : results) {
+        if (!result.error.empty()) {
+            ++errors;
+        } else if (!case_passed(result)) {
+            ++failures;
+        }
+    }
+    const std::string counts = " tests=\"" + std::to_string(results.size()) + "\" failures=\"" +
+                               std::to_string(failures) + "\" errors=\"" + std::to_string(errors) + "\"";
+    const std::string run_time = format_fixed(summary.wall_seconds, 3);
+
+    std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    xml += "<testsuites name=\"rig\"" + counts + " time=\"" + run_time + "\">\n";
+    xml += "  <testsuite name=\"rig\"" + counts + " skipped=\"0\" time=\"" + run_time + "\">\n";
+    for (const CaseResult& result : results) {
+        xml += "    <testcase classname=\"rig\" name=\"" + xml_escape(result.name, true) + "\" file=\"" +
+               xml_escape(result.file, true) + "\" time=\"" + format_fixed(result.wall_seconds, 3) + "\">\n";
+        if (!result.error.empty()) {
+            xml += "      <error type=\"error\" message=\"" + xml_escape(result.error, true) + "\">" +
+                   xml_escape(result.error + "\n" + join_lines(result.failures), false) + "</error>\n";
+        } else if (!case_passed(result)) {
+            const std::string headline =
+                result.failures.empty() ? std::string("case failed") : result.failures.front();
+            xml += "      <failure type=\"limit\" message=\"" + xml_escape(headline, true) + "\">" +
+                   xml_escape(join_lines(result.failures), false) + "</failure>\n";
+        }
+        std::string output = "seed: " + std::to_string(result.seed) + "\n";
+        if (result.expected_failure) output += "expected failures: " + join_lines(result.failures);
+        if (!result.trace_sha256.empty()) output += "trace: " + result.trace_path + " sha256 " + result.trace_sha256 + "\n";
+        output += metrics_text(result);
+        xml += "      <system-out>" + xml_escape(output, false) + "</system-out>\n";
+        xml += "    </testcase>\n";
+    }
+    xml += "  </testsuite>\n</testsuites>\n";
+    return xml;
+}
+
+std::string result_table(const std::vector<CaseResult>& results, const RunSummary& summary, bool color) {
+    std::size_t metric_name_width = 0;
+    for (const CaseResult& result : results) {
+        for (const auto& [name, limit] : result.limits) metric_name_width = std::max(metric_name_width, name.size());
+    }
+    std::vector<TableRow> rows;
+    for (const CaseResult& result : results) rows.push_back(make_row(result, metric_name_width));
+
+    const std::string case_header = "CASE";
+    const std::string status_header = "RESULT";
+    const std::string metrics_header = "METRICS (value / limit)";
+    std::size_t case_width = case_header.size();
+    std::size_t status_width = std::string_view("XFAIL-OK").size();
+    std::size_t metrics_width = metrics_header.size();
+    for (const TableRow& row : rows) {
+        case_width = std::max(case_width, display_width(row.name));
+        for (const std::string& line : row.metric_lines) metrics_width = std::max(metrics_width, display_width(line));
+    }
+
+    std::string table = pad_right(case_header, case_width) + "  " + pad_right(status_header, status_width) + "  " +
+                        pad_right(metrics_header, metrics_width) + "  FAILURES\n";
+    for (const TableRow& row : rows) {
+        const std::size_t lines = std::max({row.metric_lines.size(), row.failure_lines.size(), std::size_t{1}});
+        for (std::size_t line = 0; line < lines; ++line) {
+            std::string text = pad_right(line == 0 ? row.name : "", case_width) + "  ";
+            const std::string status = pad_right(line == 0 ? row.status : "", status_width);
+            text += color && line == 0 ? status_color(row.status) + status + kColorReset : status;
+            text += "  ";
+            const bool has_failure = line < row.failure_lines.size();
+            text += pad_right(line < row.metric_lines.size() ? row.metric_lines[line] : "", has_failure ? metrics_width : 0);
+            if (has_failure) {
+                const std::string& failure = row.failure_lines[line];
+                text += "  ";
+                text += color && row.status == "FAIL" ? kColorFailure + failure + kColorReset : failure;
+            }
+            while (!text.empty() && text.back() == ' ') text.pop_back();
+            table += text + '\n';
+        }
+    }
+    table += "\nsimulated " + format_fixed(summary.sim_seconds, 1) + " s in " + format_fixed(summary.wall_seconds, 1) +
+             " s wall\n";
+    // Kept alone on the last line: CI log readers look for "N passed, N failed".
+    table += std::to_string(summary.passed) + " passed, " + std::to_string(summary.failed) + " failed\n";
+    return table;
+}
+
+std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary) {
+    std::string report = result_table(results, summary, /*color=*/false);
+    for (const CaseResult& result : results) {
+        report += "\n== " + result.name + " (" + result.file + ")\n";
+        report += "result: " + status_word(result) + "   seed: " + std::to_string(result.seed) +
+                  "   simulated: " + format_fixed(result.sim_seconds, 3) +
+                  " s   wall: " + format_fixed(result.wall_seconds, 3) + " s\n";
+        if (!result.trace_path.empty() || !result.trace_sha256.empty()) {
+            report += "trace: " + result.trace_path + "   sha256: " + result.trace_sha256 + "\n";
+        }
+        if (!result.error.empty()) report += "error: " + result.error + "\n";
+        if (!result.metrics.empty()) {
+            report += "metrics:\n";
+            for (const auto& [name, value] : result.metrics) {
+                report += "  " + name + " = " + format_g(value, 6);
+                if (const auto limit = result.limits.find(name); limit != result.limits.end()) {
+                    report += "   (limit " + format_g(limit->second, 6) + ")";
+                }
+                report += '\n';
+            }
+        }
+        for (const std::string& failure : result.failures) report += "failure: " + failure + "\n";
+    }
+    return report;
+}
+
+void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
+                   const RunSummary& summary) {
+    std::filesystem::create_directories(out_dir);
+    const std::string json_text =
+        results_json(results, summary).dump(2) + "\n";
+    write_file_atomically(out_dir / "results.json", json_text);
+    write_file_atomically(out_dir / "junit.xml", junit_xml(results, summary));
+    write_file_atomically(out_dir / "report.txt", result_report(results, summary));
+}
+
+}  // namespace rig::harness

@@ -1,0 +1,101 @@
+#pragma once
+// Judging metrics against limits, and the run's outputs (DESIGN.md "Results
+// contract"): results.json, junit.xml and the human report / terminal table.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rig::harness {
+
+struct CaseResult {
+    std::string name;
+    std::string file;               // the case file
+    bool passed = false;            // verdict, including the expect.fail logic (judge_case)
+    bool expected_failure = false;  // the case has expect.fail (a negative case)
+    std::uint64_t seed = 1;
+    std::map<std::string, double> metrics;
+    std::map<std::string, double> limits;  // effective limits the case was judged against
+    std::vector<std::string> failures;     // e.g. "overlap_m 3.61 > 3.3"
+    std::string error;  // non-empty: the case did not run to the end (node died, bad config...); always a failure
+    std::string trace_sha256;
+    std::string trace_path;
+    double sim_seconds = 0.0;
+    double wall_seconds = 0.0;
+    double startup_wall_seconds = 0.0;  // of wall_seconds: process start, DDS discovery, hello
+};
+
+struct RunSummary {
+    int passed = 0;
+    int failed = 0;
+    double sim_seconds = 0.0;
+    double wall_seconds = 0.0;
+};
+
+// ------------------------------------------------------------------ judging
+
+// One failure per limited metric that is over its limit ("overlap_m 3.61 > 3.3";
+// equal to the limit passes) or that is missing or NaN ("breakpoint_error_m
+// missing"), in metric-name order. Numbers are printed with just enough digits
+// that value and limit differ on screen. Unlimited metrics are never failures.
+std::vector<std::string> judge(const std::map<std::string, double>& metrics,
+                               const std::map<std::string, double>& limits);
+
+// Without expectations: passes when nothing failed. With expect.fail: passes
+// only when exactly those metrics broke their limits (a missing metric never
+// counts as an expected break: it means the harness did not measure it).
+bool passes_with_expectation(const std::vector<std::string>& failures, const std::vector<std::string>& expect_fail);
+
+// Why passes_with_expectation() said no, one line per reason; empty when it passes.
+std::vector<std::string> unmet_expectations(const std::vector<std::string>& failures,
+                                            const std::vector<std::string>& expect_fail);
+
+struct CaseVerdict {
+    bool passed = false;
+    bool expected_failure = false;
+    // judge()'s failures, then any unmet expectations: what CaseResult::failures should hold.
+    std::vector<std::string> failures;
+};
+CaseVerdict judge_case(const std::map<std::string, double>& metrics, const std::map<std::string, double>& limits,
+                       const std::vector<std::string>& expect_fail);
+
+// A case counts as passed only when `passed` is set and there is no error.
+bool case_passed(const CaseResult& result);
+
+// Counts and adds up the cases. wall_seconds is the sum of the cases' wall
+// times; a run with --jobs > 1 should overwrite it with its own elapsed time.
+RunSummary summarize(const std::vector<CaseResult>& results);
+
+// ------------------------------------------------------------------ outputs
+
+// The DESIGN.md contract: {"cases": [{name, passed, seed, metrics, limits,
+// failures, trace_sha256, + file, expected_failure, error (null when none),
+// trace_path, sim_seconds, wall_seconds}], "summary": {passed, failed,
+// sim_seconds, wall_seconds, + total}}. NaN metrics become null; malformed
+// UTF-8 in any string is replaced by U+FFFD, so dump() never throws.
+nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary);
+
+// JUnit XML (one <testsuite name="rig">, one <testcase> per case): a failed case
+// has <failure message="first failure"> with every failure in its text; a case
+// with an error has <error> instead. Metrics and seed go in <system-out>.
+// Text is XML-escaped, invalid UTF-8 and characters XML 1.0 forbids are replaced.
+std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& summary);
+
+// The terminal table: case | PASS / FAIL / XFAIL-OK | limited metrics as
+// "value / limit" | failures, then a timing line and a last line
+// "N passed, M failed". `color` adds ANSI colours (for a terminal only).
+std::string result_table(const std::vector<CaseResult>& results, const RunSummary& summary, bool color);
+
+// The table followed by per-case details (file, seed, trace, all metrics, error).
+std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary);
+
+// Writes out_dir/results.json, junit.xml and report.txt (creating out_dir),
+// each through a temporary file renamed into place, so a reader never sees a
+// half-written file. Throws std::runtime_error / std::filesystem::filesystem_error.
+void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
+                   const RunSummary& summary);
+
+}  // namespace rig::harness

@@ -1,0 +1,18 @@
+#pragma once
+// Readable JSON for every topic type: what the trace stores and what the report
+// reads. Field names are the IDL's (units in the names).
+#include <nlohmann/json.hpp>
+
+#include "msg_traits.h"
+
+namespace rig::harness {
+
+nlohmann::json to_json(const msg::NmeaSentence& sample);
+nlohmann::json to_json(const msg::EncoderCount& sample);
+nlohmann::json to_json(const msg::ButtonLevel& sample);
+nlohmann::json to_json(const msg::ControllerStatus& sample);
+nlohmann::json to_json(const msg::BreakpointEvent& sample);
+nlohmann::json to_json(const msg::VehicleTruth& sample);
+const char* to_string(msg::BreakpointEventKind kind);
+
+}  // namespace rig::harness

@@ -1,0 +1,553 @@
+// Case files: a full file, defaults, and a table of broken files with the exact
+// `file:line:col: key:` each must be reported at.
+#include "harness/case_spec.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "rig/config_error.h"
+#include "rig/yaml_fields.h"
+
+namespace rig::harness {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// A fresh directory per test, removed afterwards.
+class TempDir {
+public:
+    TempDir() {
+        std::random_device entropy;
+        path_ = fs::temp_directory_path() /
+                ("case_spec_test_" + std::to_string(::getpid()) + "_" + std::to_string(entropy()));
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ignored;
+        fs::remove_all(path_, ignored);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    fs::path write(const std::string& name, const std::string& content) const {
+        const fs::path file = path_ / name;
+        std::ofstream(file, std::ios::binary) << content;
+        return file;
+    }
+    const fs::path& path() const { return path_; }
+
+private:
+    fs::path path_;
+};
+
+// The schema's example, every key given.
+constexpr const char* kFullCase = R"(name: breakpoint-6kmh-fusion-s1
+description: "free text"
+seed: 7
+mode: realtime
+utc_start: "2023-07-15T02:00:00.25Z"
+field:
+  origin: { lat_deg: 40.18, lon_deg: 116.44, height_m: 50.0 }
+  heading_deg: 90
+vehicle:
+  speed_km_h: 6.0
+  accel_m_s2: 0.4
+  start_m: -60
+  overrun_m: 7
+boom: { l1_m: 0.55, l2_m: 0.85, l3_m: 0.40, linkage_rise_m: 0.6 }
+breakpoint:
+  along_m: 2.5
+  button_at_s: 1.5
+gnss:
+  talker: GN
+  rate_hz: 10
+  latency_s: 0.05
+  fix: rtk_float
+  noise: { base_m: 0.01, ppm: 2.0, baseline_km: 5.0 }
+  dropouts:   [ { at_s: 31.0, for_s: 0.6 }, { at_s: 40, for_s: 1 } ]
+  degraded:   [ { at_s: 20.0, for_s: 2.0, fix: dgps, sigma_m: 0.3 } ]
+encoder:
+  pulses_per_rev: 2000
+  wheel_diameter_m: 0.9
+  rate_hz: 200
+  slip_pct: 1.5
+  slip_sd_pct: 0.5
+controller:
+  command: [ "rig-controller", "--verbose" ]
+  positioning: fusion
+  pid: { kp: 0.20, ki: 0.18, kd: 0.001 }
+limits:
+  breakpoint_error_m: 0.2
+  overlap_m: 3.3
+expect:
+  fail: [ overlap_m ]
+timeouts:
+  node_ack_s: 20
+  case_wall_s: 900
+)";
+
+// Only what has no default.
+constexpr const char* kMinimalCase = R"(name: minimal
+field:
+  origin: { lat_deg: 40.18, lon_deg: 116.44 }
+  heading_deg: 90
+vehicle:
+  speed_km_h: 6.0
+  start_m: -60
+)";
+
+TEST(CaseSpec, FullFileParsesToTheWrittenValues) {
+    TempDir dir;
+    const fs::path file = dir.write("full.yaml", kFullCase);
+    const CaseSpec spec = load_case_file(file);
+
+    EXPECT_EQ(spec.source_path, file);
+    EXPECT_EQ(spec.name, "breakpoint-6kmh-fusion-s1");
+    EXPECT_EQ(spec.description, "free text");
+    EXPECT_EQ(spec.seed, 7u);
+    EXPECT_EQ(spec.mode, RunMode::realtime);
+    EXPECT_EQ(spec.utc_start_iso, "2023-07-15T02:00:00.25Z");
+    EXPECT_EQ(spec.utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h + 250ms);
+
+    EXPECT_DOUBLE_EQ(spec.field.origin.lat_deg, 40.18);
+    EXPECT_DOUBLE_EQ(spec.field.origin.lon_deg, 116.44);
+    EXPECT_DOUBLE_EQ(spec.field.origin.height_m, 50.0);
+    EXPECT_DOUBLE_EQ(spec.field.heading_deg, 90.0);
+
+    EXPECT_DOUBLE_EQ(spec.vehicle.speed_km_h, 6.0);
+    EXPECT_DOUBLE_EQ(spec.vehicle.accel_m_s2, 0.4);
+    EXPECT_DOUBLE_EQ(spec.vehicle.start_m, -60.0);
+    EXPECT_DOUBLE_EQ(spec.vehicle.overrun_m, 7.0);
+
+    EXPECT_DOUBLE_EQ(spec.boom.l1_m, 0.55);
+    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.85);
+    EXPECT_DOUBLE_EQ(spec.boom.l3_m, 0.40);
+    EXPECT_DOUBLE_EQ(spec.boom.linkage_rise_m, 0.6);
+
+    EXPECT_DOUBLE_EQ(spec.breakpoint.along_m, 2.5);
+    EXPECT_DOUBLE_EQ(spec.breakpoint.button_at_s, 1.5);
+
+    EXPECT_EQ(spec.gnss.talker, GnssTalker::gn);
+    EXPECT_EQ(to_string(spec.gnss.talker), "GN");
+    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 10.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.05);
+    EXPECT_EQ(spec.gnss.fix, GnssFix::rtk_float);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.base_m, 0.01);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.ppm, 2.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.baseline_km, 5.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.horizontal_sigma_m(), 0.02);
+    ASSERT_EQ(spec.gnss.dropouts.size(), 2u);
+    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[0].at_s, 31.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[0].for_s, 0.6);
+    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[1].at_s, 40.0);
+    ASSERT_EQ(spec.gnss.degraded.size(), 1u);
+    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].at_s, 20.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].for_s, 2.0);
+    EXPECT_EQ(spec.gnss.degraded[0].fix, GnssFix::dgps);
+    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].sigma_m, 0.3);
+
+    EXPECT_EQ(spec.encoder.pulses_per_rev, 2000u);
+    EXPECT_DOUBLE_EQ(spec.encoder.wheel_diameter_m, 0.9);
+    EXPECT_DOUBLE_EQ(spec.encoder.rate_hz, 200.0);
+    EXPECT_DOUBLE_EQ(spec.encoder.slip_pct, 1.5);
+    EXPECT_DOUBLE_EQ(spec.encoder.slip_sd_pct, 0.5);
+
+    EXPECT_EQ(spec.controller.command, (std::vector<std::string>{"rig-controller", "--verbose"}));
+    ASSERT_TRUE(spec.controller.params.present);
+    EXPECT_EQ(spec.controller.params.node["positioning"].as<std::string>(), "fusion");
+    EXPECT_DOUBLE_EQ(spec.controller.params.node["pid"]["ki"].as<double>(), 0.18);
+    EXPECT_EQ(spec.controller.params.location.file, file.string());
+    EXPECT_EQ(spec.controller.params.location.line, 33);  // its first key
+    EXPECT_EQ(spec.controller.params.location.key_path, "controller");
+
+    EXPECT_EQ(spec.limits, (std::map<std::string, double>{{"breakpoint_error_m", 0.2}, {"overlap_m", 3.3}}));
+    EXPECT_EQ(spec.expect.fail, (std::vector<std::string>{"overlap_m"}));
+    EXPECT_DOUBLE_EQ(spec.timeouts.node_ack_s, 20.0);
+    EXPECT_DOUBLE_EQ(spec.timeouts.case_wall_s, 900.0);
+
+    // The file's limits win over the defaults.
+    EXPECT_EQ(effective_limits(spec), spec.limits);
+}
+
+TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
+    TempDir dir;
+    const CaseSpec spec = load_case_file(dir.write("minimal.yaml", kMinimalCase));
+    const CaseSpec defaults;
+
+    EXPECT_EQ(spec.name, "minimal");
+    EXPECT_EQ(spec.description, "");
+    EXPECT_EQ(spec.seed, 1u);
+    EXPECT_EQ(spec.mode, RunMode::lockstep);
+    EXPECT_EQ(spec.utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h);
+    EXPECT_DOUBLE_EQ(spec.field.origin.height_m, 0.0);
+    EXPECT_DOUBLE_EQ(spec.vehicle.accel_m_s2, 0.5);
+    EXPECT_DOUBLE_EQ(spec.vehicle.overrun_m, 5.0);
+    EXPECT_DOUBLE_EQ(spec.boom.l1_m, 0.50);
+    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.80);
+    EXPECT_DOUBLE_EQ(spec.boom.l3_m, 0.45);
+    EXPECT_DOUBLE_EQ(spec.boom.linkage_rise_m, 0.50);
+    EXPECT_DOUBLE_EQ(spec.breakpoint.along_m, 0.0);
+    EXPECT_DOUBLE_EQ(spec.breakpoint.button_at_s, 1.0);
+    EXPECT_EQ(spec.gnss.talker, GnssTalker::gp);
+    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 5.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.02);
+    EXPECT_EQ(spec.gnss.fix, GnssFix::rtk_fixed);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.base_m, 0.008);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.ppm, 1.0);
+    EXPECT_DOUBLE_EQ(spec.gnss.noise.baseline_km, 2.0);
+    EXPECT_TRUE(spec.gnss.dropouts.empty());
+    EXPECT_TRUE(spec.gnss.degraded.empty());
+    EXPECT_EQ(spec.encoder.pulses_per_rev, 1000u);
+    EXPECT_DOUBLE_EQ(spec.encoder.wheel_diameter_m, 1.0);
+    EXPECT_DOUBLE_EQ(spec.encoder.rate_hz, 100.0);
+    EXPECT_DOUBLE_EQ(spec.encoder.slip_pct, defaults.encoder.slip_pct);
+    EXPECT_DOUBLE_EQ(spec.encoder.slip_sd_pct, defaults.encoder.slip_sd_pct);
+    EXPECT_TRUE(spec.controller.command.empty());
+    EXPECT_FALSE(spec.controller.params.present);
+    EXPECT_TRUE(spec.limits.empty());
+    EXPECT_TRUE(spec.expect.fail.empty());
+    EXPECT_DOUBLE_EQ(spec.timeouts.node_ack_s, 10.0);
+    EXPECT_DOUBLE_EQ(spec.timeouts.case_wall_s, 600.0);
+    EXPECT_EQ(effective_limits(spec), kDefaultLimits);
+}
+
+TEST(CaseSpec, EmptySectionsTakeDefaultsAndDefaultLimitsCanBeExpectedToFail) {
+    TempDir dir;
+    const CaseSpec spec = load_case_file(dir.write("empty-sections.yaml", std::string(kMinimalCase) + R"(gnss:
+boom: {}
+expect: { fail: [ breakpoint_error_m ] }
+)"));
+    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 5.0);
+    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.80);
+    EXPECT_EQ(spec.expect.fail, (std::vector<std::string>{"breakpoint_error_m"}));
+}
+
+TEST(CaseSpec, HarnessCanExtendTheDefaultLimits) {
+    std::map<std::string, double> defaults = kDefaultLimits;
+    defaults["overlap_m"] = 3.3;
+    const std::string text = std::string(kMinimalCase) + "expect: { fail: [ overlap_m ] }\n";
+    EXPECT_THROW(parse_case(text, "case.yaml"), ConfigError);
+    const CaseSpec spec = parse_case(text, "case.yaml", defaults);
+    EXPECT_EQ(effective_limits(spec, defaults).at("overlap_m"), 3.3);
+}
+
+// ------------------------------------------------------------------ broken files
+
+struct BrokenFile {
+    const char* legend;
+    std::string content;
+    // What what() must start with after "<file>:" — "LINE:COL: KEY:".
+    const char* location_and_key;
+    // And a piece of the message.
+    const char* message_part;
+};
+
+// The minimal case with one line replaced (1-based), to keep positions obvious.
+std::string minimal_with_line(int line_number, const std::string& replacement) {
+    std::string out;
+    std::istringstream lines(kMinimalCase);
+    std::string line;
+    for (int number = 1; std::getline(lines, line); ++number) out += (number == line_number ? replacement : line) + "\n";
+    return out;
+}
+
+const std::vector<BrokenFile>& broken_files() {
+    static const std::vector<BrokenFile> table = {
+        {"YAML syntax error: an unclosed flow sequence",
+         "name: t\nfield: [ 1, 2\nvehicle: {}\n", "3:8: (document):", "YAML syntax error"},
+        {"unknown key: a typo is named, with the closest known key",
+         minimal_with_line(6, "  speed_kmh: 6.0"), "6:3: vehicle.speed_kmh:",
+         "unknown key 'speed_kmh'; did you mean 'speed_km_h'?"},
+        {"unknown key: the bare quantity without its unit suffix",
+         minimal_with_line(6, "  speed: 6.0"), "6:3: vehicle.speed:", "did you mean 'speed_km_h'?"},
+        {"unknown key: a misspelt section name",
+         minimal_with_line(5, "vehical:"), "5:1: vehical:", "did you mean 'vehicle'?"},
+        {"unknown key: nothing close, so the known keys are listed",
+         std::string(kMinimalCase) + "gnss: { colour: red }\n", "8:9: gnss.colour:",
+         "known keys here: degraded, dropouts, fix, latency_s, noise, rate_hz, talker"},
+        {"wrong type: a word where a number belongs",
+         minimal_with_line(6, "  speed_km_h: fast"), "6:15: vehicle.speed_km_h:", "expected a number, got 'fast'"},
+        {"wrong type: a quoted number",
+         minimal_with_line(6, "  speed_km_h: \"6\""), "6:15: vehicle.speed_km_h:",
+         "expected a number, got the quoted string '6' (write it without quotes)"},
+        {"wrong type: a fraction where an integer belongs",
+         std::string(kMinimalCase) + "encoder: { pulses_per_rev: 1000.5 }\n", "8:28: encoder.pulses_per_rev:",
+         "expected a non-negative integer, got '1000.5'"},
+        {"wrong type: a negative seed",
+         std::string(kMinimalCase) + "seed: -1\n", "8:7: seed:", "expected a non-negative integer, got '-1'"},
+        {"wrong type: an empty value is reported at its key, not on the next line",
+         minimal_with_line(6, "  speed_km_h:"), "6:3: vehicle.speed_km_h:", "empty value, expected a number"},
+        {"out of range: below an open lower bound",
+         std::string(kMinimalCase) + "gnss:\n  rate_hz: -5\n", "9:12: gnss.rate_hz:", "must be > 0, got -5"},
+        {"out of range: above a closed upper bound",
+         minimal_with_line(6, "  speed_km_h: 45"), "6:15: vehicle.speed_km_h:", "must be <= 30, got 45"},
+        {"out of range: inside a list item, with the item index in the path",
+         std::string(kMinimalCase) + "gnss:\n  dropouts: [ { at_s: 1, for_s: 1 }, { at_s: 2, for_s: 0 } ]\n",
+         "9:56: gnss.dropouts[1].for_s:", "must be > 0, got 0"},
+        {"missing required key: reported at the parent mapping",
+         minimal_with_line(7, ""), "6:3: vehicle.start_m:", "required key missing"},
+        {"missing required key: inside a list item",
+         std::string(kMinimalCase) + "gnss:\n  dropouts:\n    - { at_s: 1, for_s: 1 }\n    - { at_s: 2 }\n",
+         "11:7: gnss.dropouts[1].for_s:", "required key missing"},
+        {"missing required section",
+         "name: t\nfield:\n  origin: { lat_deg: 1, lon_deg: 2 }\n  heading_deg: 0\n", "1:1: vehicle:",
+         "required section missing"},
+        {"missing required key: name",
+         minimal_with_line(1, ""), "2:1: name:", "required key missing"},
+        {"sequence where a mapping is expected",
+         std::string(kMinimalCase) + "gnss: [ 5 ]\n", "8:7: gnss:", "expected a mapping (key: value), got a sequence"},
+        {"mapping where a sequence is expected",
+         std::string(kMinimalCase) + "gnss: { dropouts: { at_s: 1 } }\n", "8:19: gnss.dropouts:",
+         "expected a sequence"},
+        {"list item that is not a mapping",
+         std::string(kMinimalCase) + "gnss: { dropouts: [ 5 ] }\n", "8:21: gnss.dropouts[0]:",
+         "expected a mapping (key: value), got '5'"},
+        {"bad enum value, with a suggestion",
+         std::string(kMinimalCase) + "mode: lockstp\n", "8:7: mode:",
+         "must be one of lockstep, realtime; got 'lockstp' (did you mean 'lockstep'?)"},
+        {"bad enum value inside a list item",
+         std::string(kMinimalCase) + "gnss: { degraded: [ { at_s: 1, for_s: 1, sigma_m: 0.3, fix: rtk } ] }\n",
+         "8:61: gnss.degraded[0].fix:", "must be one of rtk_fixed, rtk_float, dgps, autonomous"},
+        {"cross-field: start_m not before the breakpoint",
+         minimal_with_line(7, "  start_m: 3") + "breakpoint: { along_m: 2.5 }\n", "7:12: vehicle.start_m:",
+         "must be < breakpoint.along_m (2.5) so the vehicle approaches the breakpoint, got 3"},
+        {"bad limit name: no unit suffix",
+         std::string(kMinimalCase) + "limits:\n  breakpoint_error: 0.16\n", "9:3: limits.breakpoint_error:",
+         "metric name 'breakpoint_error' has no unit suffix"},
+        {"bad limit name: not snake_case",
+         std::string(kMinimalCase) + "limits: { Overlap_M: 3.3 }\n", "8:11: limits.Overlap_M:", "is not snake_case"},
+        {"limit value that is not a number",
+         std::string(kMinimalCase) + "limits: { overlap_m: [ 3 ] }\n", "8:22: limits.overlap_m:",
+         "expected a number, got a sequence"},
+        {"expect.fail names a metric without a limit",
+         std::string(kMinimalCase) + "limits: { overlap_m: 3.3 }\nexpect:\n  fail: [ overlap_m, missed_m ]\n",
+         "10:22: expect.fail[1]:", "'missed_m' has no limit"},
+        {"expect.fail written as a scalar",
+         std::string(kMinimalCase) + "expect: { fail: breakpoint_error_m }\n", "8:17: expect.fail:",
+         "write [ breakpoint_error_m ]"},
+        {"duplicate key",
+         std::string(kMinimalCase) + "seed: 1\nseed: 2\n", "9:1: seed:", "duplicate key 'seed' (first at line 8, column 1)"},
+        {"empty file", "", "1:1: (document):", "the file is empty"},
+        {"a file with only comments is empty too", "# nothing yet\n", "1:1: (document):", "the file is empty"},
+        {"top level is a list", "- name: t\n", "1:1: (document):", "expected a mapping of settings"},
+        {"two YAML documents in one file",
+         std::string(kMinimalCase) + "---\nname: u\n", "9:1: (document):", "a second YAML document"},
+        {"bad case name", minimal_with_line(1, "name: bad name!"), "1:7: name:",
+         "must be letters, digits, '.', '_' or '-'"},
+        {"utc_start not in UTC", std::string(kMinimalCase) + "utc_start: 2023-07-15T02:00:00+08:00\n",
+         "8:12: utc_start:", "expected an ISO-8601 UTC time"},
+        {"utc_start with an impossible date", std::string(kMinimalCase) + "utc_start: 2023-02-30T02:00:00Z\n",
+         "8:12: utc_start:", "expected an ISO-8601 UTC time"},
+        {"controller that is not a mapping", std::string(kMinimalCase) + "controller: fusion\n", "8:13: controller:",
+         "expected a mapping"},
+        {"controller command that names nothing", std::string(kMinimalCase) + "controller: { command: [] }\n",
+         "8:24: controller.command:", "must name the controller executable"},
+        // yaml-cpp gives an alias the mark of the node it refers to.
+        {"an alias that contains itself", std::string(kMinimalCase) + "controller: &loop { again: *loop }\n",
+         "8:13: controller.again:", "an alias refers to its own ancestor"},
+    };
+    return table;
+}
+
+TEST(CaseSpec, BrokenFilesAreReportedAtFileLineColumnAndKey) {
+    TempDir dir;
+    int index = 0;
+    for (const BrokenFile& broken : broken_files()) {
+        SCOPED_TRACE(broken.legend);
+        const fs::path file = dir.write("broken-" + std::to_string(index++) + ".yaml", broken.content);
+        try {
+            load_case_file(file);
+            ADD_FAILURE() << "no error for: " << broken.legend;
+        } catch (const ConfigError& error) {
+            const std::string what = error.what();
+            const std::string expected_prefix = file.string() + ":" + broken.location_and_key;
+            EXPECT_EQ(what.rfind(expected_prefix, 0), 0u) << "what(): " << what << "\nexpected prefix: " << expected_prefix;
+            EXPECT_NE(what.find(broken.message_part), std::string::npos)
+                << "what(): " << what << "\nexpected to contain: " << broken.message_part;
+            EXPECT_EQ(error.file(), file.string());
+        }
+    }
+}
+
+TEST(CaseSpec, ErrorFormatIsFileLineColumnKeyMessage) {
+    const ConfigError error(SourceLocation{"cases/bp.yaml", 14, 12, "gnss.rate_hz"}, "must be > 0, got -5");
+    EXPECT_STREQ(error.what(), "cases/bp.yaml:14:12: gnss.rate_hz: must be > 0, got -5");
+    EXPECT_EQ(error.line(), 14);
+    EXPECT_EQ(error.column(), 12);
+    EXPECT_EQ(error.key_path(), "gnss.rate_hz");
+    EXPECT_EQ(error.message(), "must be > 0, got -5");
+}
+
+TEST(CaseSpec, MissingFileIsAnErrorNamingIt) {
+    TempDir dir;
+    const fs::path file = dir.path() / "no-such-case.yaml";
+    try {
+        load_case_file(file);
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_EQ(std::string(error.what()), file.string() + ": (file): no such file");
+        EXPECT_EQ(error.line(), 0);
+    }
+}
+
+TEST(CaseSpec, DirectoryGivenAsCaseFileIsAnError) {
+    TempDir dir;
+    EXPECT_THROW(
+        {
+            try {
+                load_case_file(dir.path());
+            } catch (const ConfigError& error) {
+                EXPECT_NE(std::string(error.what()).find("is a directory"), std::string::npos);
+                throw;
+            }
+        },
+        ConfigError);
+}
+
+TEST(CaseSpec, ExpandCasePathsSortsADirectoryAndKeepsFiles) {
+    TempDir dir;
+    fs::create_directories(dir.path() / "suite" / "nested");
+    dir.write("suite/b.yml", kMinimalCase);
+    dir.write("suite/a.yaml", kMinimalCase);
+    dir.write("suite/c.yaml", kMinimalCase);
+    dir.write("suite/notes.txt", "not a case");
+    dir.write("suite/.hidden.yaml", kMinimalCase);
+    dir.write("suite/nested/deep.yaml", kMinimalCase);
+    const fs::path single = dir.write("single.case", kMinimalCase);
+
+    const auto paths = expand_case_paths({single.string(), (dir.path() / "suite").string()});
+    const std::vector<fs::path> expected = {single, dir.path() / "suite" / "a.yaml", dir.path() / "suite" / "b.yml",
+                                            dir.path() / "suite" / "c.yaml"};
+    EXPECT_EQ(paths, expected);
+}
+
+TEST(CaseSpec, ExpandCasePathsRejectsMissingPathsAndEmptyDirectories) {
+    TempDir dir;
+    const std::string missing = (dir.path() / "nope").string();
+    try {
+        expand_case_paths({missing});
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_EQ(std::string(error.what()), missing + ": (file): no such case file or directory");
+    }
+    fs::create_directories(dir.path() / "empty");
+    try {
+        expand_case_paths({(dir.path() / "empty").string()});
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_NE(std::string(error.what()).find("directory has no *.yaml or *.yml case files"), std::string::npos);
+    }
+}
+
+TEST(CaseSpec, MetricNames) {
+    EXPECT_EQ(metric_name_problem("breakpoint_error_m"), "");
+    EXPECT_EQ(metric_name_problem("flow_error_pct"), "");
+    EXPECT_EQ(metric_name_problem("main_flow_l_min"), "");
+    EXPECT_EQ(metric_name_problem("missed_count"), "");
+    EXPECT_EQ(metric_name_problem("deposition_cv_pct"), "");
+    EXPECT_NE(metric_name_problem("m"), "");          // a unit alone
+    EXPECT_NE(metric_name_problem("_m"), "");
+    EXPECT_NE(metric_name_problem("overlap"), "");
+    EXPECT_NE(metric_name_problem("overlap__m"), "");
+    EXPECT_NE(metric_name_problem("overlap-m"), "");
+    EXPECT_NE(metric_name_problem("overlap_m_"), "");
+    EXPECT_NE(metric_name_problem("overlap_furlongs"), "");
+}
+
+// ------------------------------------------------------------------ the YAML layer itself
+
+TEST(YamlSection, ControllerCanValidateItsOwnSectionWithLocations) {
+    const CaseSpec spec = parse_case(std::string(kMinimalCase) + "controller:\n  command: [ x ]\n  threshold: 5\n",
+                                     "cases/c.yaml");
+    const YamlSection controller(spec.controller.params);
+    for (const std::string_view rig_key : kControllerRigKeys) controller.allow(rig_key);
+    EXPECT_DOUBLE_EQ(controller.optional<double>("threshold_m", 5.0), 5.0);
+    try {
+        controller.finish();
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_STREQ(error.what(),
+                     "cases/c.yaml:10:3: controller.threshold: unknown key 'threshold'; did you mean 'threshold_m'?");
+    }
+}
+
+TEST(YamlSection, AbsentRawSectionReportsAtItsParent) {
+    const CaseSpec spec = parse_case(kMinimalCase, "cases/c.yaml");
+    const YamlSection controller(spec.controller.params);
+    EXPECT_FALSE(controller.present());
+    (void)controller.required<double>("threshold_m");
+    try {
+        controller.finish();
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_STREQ(error.what(),
+                     "cases/c.yaml:1:1: controller.threshold_m: required key missing (the whole 'controller' section "
+                     "is absent)");
+    }
+}
+
+TEST(YamlSection, ScalarConversions) {
+    const YamlSection section =
+        YamlSection::load_string("a: +1.5e2\nb: true\nc: 18446744073709551615\nd: 7\ne: .inf\nf: 99999999999\n", "t");
+    EXPECT_DOUBLE_EQ(section.required<double>("a"), 150.0);
+    EXPECT_TRUE(section.required<bool>("b"));
+    EXPECT_EQ(section.required<std::uint64_t>("c"), 18446744073709551615u);
+    EXPECT_EQ(section.required<int>("d"), 7);
+    EXPECT_EQ(section.maybe<int>("missing"), std::nullopt);
+    EXPECT_THROW(section.required<double>("e"), ConfigError);
+    try {
+        section.required<int>("f");
+        FAIL() << "no error";
+    } catch (const ConfigError& error) {
+        EXPECT_STREQ(error.what(), "t:6:4: f: must be between -2147483648 and 2147483647, got '99999999999'");
+    }
+}
+
+TEST(YamlSection, StringEnumsListsAndKeys) {
+    const YamlSection root = YamlSection::load_string(
+        "mode: realtime\nitems: [ { id: a }, { id: b } ]\ntags: [ x, y ]\nmap: { k1: 1, k2: 2 }\n", "t");
+    EXPECT_EQ(root.optional_enum("mode", {"lockstep", "realtime"}, "lockstep"), "realtime");
+    EXPECT_EQ(root.optional_enum("absent", {"lockstep", "realtime"}, "lockstep"), "lockstep");
+    std::vector<std::string> ids;
+    for (const YamlSection& item : root.list("items")) ids.push_back(item.required<std::string>("id"));
+    EXPECT_EQ(ids, (std::vector<std::string>{"a", "b"}));
+    EXPECT_EQ(root.list("items")[1].key_path(), "items[1]");
+    EXPECT_EQ(root.string_list("tags"), (std::vector<std::string>{"x", "y"}));
+    const YamlSection map = root.section("map");
+    EXPECT_EQ(map.keys(), (std::vector<std::string>{"k1", "k2"}));
+    EXPECT_THROW(map.finish(), ConfigError);  // keys() alone does not make keys known
+    map.allow("k1");
+    map.allow("k2");
+    EXPECT_NO_THROW(root.finish());
+    EXPECT_TRUE(root.section("absent").keys().empty());
+    EXPECT_FALSE(root.section("absent").present());
+}
+
+TEST(YamlSection, BoundsDescribeThemselves) {
+    EXPECT_EQ(Bounds::open_closed(0, 30).describe(), "(0, 30]");
+    EXPECT_EQ(Bounds::at_least(0).describe(), "[0, +inf)");
+    EXPECT_EQ(Bounds::closed_open(0, 360).violation(360), "must be < 360");
+    EXPECT_EQ(Bounds::greater_than(0).violation(0), "must be > 0");
+    EXPECT_FALSE(Bounds::closed(-20, 20).violation(20).has_value());
+}
+
+TEST(YamlSection, ClosestSpelling) {
+    const std::vector<std::string> keys = {"lat_deg", "lon_deg", "height_m"};
+    EXPECT_EQ(closest_spelling("lat_dge", keys), "lat_deg");
+    EXPECT_EQ(closest_spelling("height", keys), "height_m");
+    EXPECT_EQ(closest_spelling("colour", keys), std::nullopt);
+    const std::vector<std::string> fixes = {"rtk_fixed", "rtk_float", "dgps", "autonomous"};
+    EXPECT_EQ(closest_spelling("float", fixes), "rtk_float");
+    EXPECT_EQ(closest_spelling("rtk_fixd", fixes), "rtk_fixed");
+}
+
+}  // namespace
+}  // namespace rig::harness
