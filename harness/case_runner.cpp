@@ -170,13 +170,6 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
             plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m, scenario.approach_starts_s);
         const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
 
-        emulators::GnssG970 gnss(plant, gnss_params(spec, result.seed, crossing_s));
-        emulators::WheelEncoder encoder(
-            plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev, spec.encoder.wheel_diameter_m,
-                                                 spec.encoder.rate_hz});
-        emulators::BreakpointButton button({emulators::ButtonPress{scenario.button_at_s, 0.2}});
-        emulators::PlantNode plant_node(plant, kTruthRateHz);
-
         // The controller under test, in its own process on this run's own domain.
         const DomainLease lease = DomainLease::acquire();
         write_controller_config(spec, case_dir / "controller.yaml");
@@ -193,6 +186,14 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
 
         DdsContext dds(lease.domain_id(), "harness");
         TraceRecorder trace(dds, case_dir / "trace.sqlite");
+        // Nodes hold DDS writers, so they are declared after (and destroyed before) the context.
+        emulators::GnssG970 gnss(plant, gnss_params(spec, result.seed, crossing_s));
+        emulators::WheelEncoder encoder(
+            plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev, spec.encoder.wheel_diameter_m,
+                                                 spec.encoder.rate_hz});
+        emulators::BreakpointButton button({emulators::ButtonPress{scenario.button_at_s, 0.2}});
+        emulators::PlantNode plant_node(plant, kTruthRateHz);
+
         trace.set_meta("case", spec.name);
         trace.set_meta("case_file", spec.source_path.string());
         trace.set_meta("seed", std::to_string(result.seed));

@@ -349,19 +349,27 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
             paths.push_back(path);
             continue;
         }
+        // Suites are folders of cases (cases/table3-fusion/...), so walk the tree;
+        // hidden files and folders (.git, editor swap files) are skipped.
         std::vector<fs::path> cases;
-        for (const fs::directory_entry& entry : fs::directory_iterator(path)) {
-            const std::string file_name = entry.path().filename().string();
-            const std::string extension = entry.path().extension().string();
-            if (file_name.starts_with('.') || (extension != ".yaml" && extension != ".yml")) continue;
-            if (!entry.is_regular_file()) continue;
-            cases.push_back(entry.path());
+        for (auto it = fs::recursive_directory_iterator(path, fs::directory_options::skip_permission_denied);
+             it != fs::recursive_directory_iterator(); ++it) {
+            const std::string file_name = it->path().filename().string();
+            if (file_name.starts_with('.')) {
+                if (it->is_directory()) it.disable_recursion_pending();
+                continue;
+            }
+            const std::string extension = it->path().extension().string();
+            if ((extension != ".yaml" && extension != ".yml") || !it->is_regular_file()) continue;
+            cases.push_back(it->path());
         }
         if (cases.empty()) {
             throw ConfigError(SourceLocation{arg, 0, 0, "(file)"}, "directory has no *.yaml or *.yml case files");
         }
-        std::sort(cases.begin(), cases.end(),
-                  [](const fs::path& a, const fs::path& b) { return a.filename().string() < b.filename().string(); });
+        // Sorted by path below the directory: suite folder, then file name.
+        std::sort(cases.begin(), cases.end(), [&path](const fs::path& a, const fs::path& b) {
+            return a.lexically_relative(path).generic_string() < b.lexically_relative(path).generic_string();
+        });
         paths.insert(paths.end(), cases.begin(), cases.end());
     }
     return paths;

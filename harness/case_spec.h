@@ -185,8 +185,8 @@ CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& fil
                     const std::map<std::string, double>& default_limits = kDefaultLimits);
 
 // Command-line case arguments to files: a file stays as given; a directory
-// becomes its `*.yaml` / `*.yml` files (not recursive, hidden files skipped),
-// sorted by file name. A missing path, or a directory with no case files, is
+// becomes the `*.yaml` / `*.yml` files anywhere below it (hidden files and
+// folders skipped), sorted by path relative to it. A missing path, or a directory with no case files, is
 // a rig::ConfigError naming it.
 std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args);
 

@@ -1,6 +1,7 @@
 // `rig`: the rig's one command line (DESIGN.md "Command line").
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
 //   rig nmea decode FILE|-
+//   rig dds-check [--samples N] [--log-dir DIR]
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -12,6 +13,7 @@
 #include "harness/results_writer.h"
 #include "rig/clock.h"
 #include "rig/config_error.h"
+#include "rig/dds_check.h"
 
 namespace {
 
@@ -88,11 +90,32 @@ int main(int argc, char** argv) {
     auto* decode = nmea->add_subcommand("decode", "decode NMEA lines with the controller's parser, one JSON per line");
     decode->add_option("input", nmea_input, "file, or - for standard input")->required();
 
+    rig::DdsCheckOptions check_options;
+    check_options.echo_executable = own_directory() / "rig";
+    check_options.log_dir = std::filesystem::temp_directory_path();
+    bool check_echo = false;
+    std::uint32_t check_domain = 0;
+    auto* check = app.add_subcommand(
+        "dds-check", "bench self-test: ping/pong with a second process over the loopback DDS profile");
+    check->add_option("--samples", check_options.samples, "round trips")->check(CLI::Range(1, 100000));
+    check->add_option("--log-dir", check_options.log_dir, "where the echo process writes its log");
+    check->add_flag("--echo", check_echo, "internal: be the echo side")->group("");
+    check->add_option("--domain", check_domain, "internal: the echo side's domain")->group("");
+
     CLI11_PARSE(app, argc, argv);
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
     }
     if (decode->parsed()) return nmea_decode_command(nmea_input);
+    if (check->parsed()) {
+        try {
+            if (check_echo) return rig::run_dds_echo(check_domain, check_options.samples, std::cout);
+            return rig::run_dds_check(check_options, std::cout);
+        } catch (const std::exception& error) {
+            std::cerr << "rig dds-check: " << error.what() << "\n";
+            return 1;
+        }
+    }
     return 2;
 }

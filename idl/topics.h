@@ -8,6 +8,10 @@ namespace rig::topics {
 inline constexpr const char* kClockTick = "rig/clock/tick";          // msg::ClockTick
 inline constexpr const char* kClockAck = "rig/clock/ack";            // msg::ClockAck
 
+// Bench self-test (rig/dds_check.h)
+inline constexpr const char* kDdsCheckPing = "rig/dds_check/ping";  // msg::NmeaSentence
+inline constexpr const char* kDdsCheckPong = "rig/dds_check/pong";  // msg::NmeaSentence
+
 // Device topics (emulators -> controller)
 inline constexpr const char* kGnssNmea = "device/gnss/nmea";         // msg::NmeaSentence
 inline constexpr const char* kWheelEncoder = "device/wheel_encoder/count";  // msg::EncoderCount

@@ -412,7 +412,7 @@ TEST(CaseSpec, DirectoryGivenAsCaseFileIsAnError) {
         ConfigError);
 }
 
-TEST(CaseSpec, ExpandCasePathsSortsADirectoryAndKeepsFiles) {
+TEST(CaseSpec, ExpandCasePathsWalksADirectoryTreeSortedAndKeepsFiles) {
     TempDir dir;
     fs::create_directories(dir.path() / "suite" / "nested");
     dir.write("suite/b.yml", kMinimalCase);
@@ -421,11 +421,14 @@ TEST(CaseSpec, ExpandCasePathsSortsADirectoryAndKeepsFiles) {
     dir.write("suite/notes.txt", "not a case");
     dir.write("suite/.hidden.yaml", kMinimalCase);
     dir.write("suite/nested/deep.yaml", kMinimalCase);
+    fs::create_directories(dir.path() / "suite" / ".git");
+    dir.write("suite/.git/config.yaml", kMinimalCase);
     const fs::path single = dir.write("single.case", kMinimalCase);
 
     const auto paths = expand_case_paths({single.string(), (dir.path() / "suite").string()});
     const std::vector<fs::path> expected = {single, dir.path() / "suite" / "a.yaml", dir.path() / "suite" / "b.yml",
-                                            dir.path() / "suite" / "c.yaml"};
+                                            dir.path() / "suite" / "c.yaml",
+                                            dir.path() / "suite" / "nested" / "deep.yaml"};
     EXPECT_EQ(paths, expected);
 }
 
