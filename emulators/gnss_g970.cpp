@@ -89,10 +89,11 @@ std::optional<nmea::GnssFix> GnssG970::solve_epoch(TimeNs epoch_ns) {
 
 TimeNs GnssG970::step(TimeNs now_ns) {
     const TimeNs period = epoch_period_ns();
+    const TimeNs phase = seconds_to_ns(params_.epoch_phase_s);
     const TimeNs latency = seconds_to_ns(params_.latency_s);
     // Emit every epoch whose sentences are due on the wire by now.
-    while (next_epoch_index_ * period + latency <= now_ns) {
-        const TimeNs epoch_ns = next_epoch_index_ * period;
+    while (phase + next_epoch_index_ * period + latency <= now_ns) {
+        const TimeNs epoch_ns = phase + next_epoch_index_ * period;
         ++next_epoch_index_;
         if (auto fix = solve_epoch(epoch_ns)) {
             for (const std::string& sentence :
@@ -103,7 +104,7 @@ TimeNs GnssG970::step(TimeNs now_ns) {
             }
         }
     }
-    return next_epoch_index_ * period + latency;
+    return phase + next_epoch_index_ * period + latency;
 }
 
 }  // namespace rig::emulators

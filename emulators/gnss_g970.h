@@ -35,6 +35,7 @@ struct G970Params {
     std::string talker = "GP";
     double rate_hz = 5.0;
     double latency_s = 0.02;
+    double epoch_phase_s = 0.0;    // epochs at epoch_phase_s + k / rate_hz, [0, 1 / rate_hz)
     GnssFixKind fix = GnssFixKind::rtk_fixed;
     double noise_base_m = 0.008;   // RTK 8 mm + 1 ppm (sec. 2.2.3)
     double noise_ppm = 1.0;

@@ -17,6 +17,9 @@ LandWheel::LandWheel(const LandWheelParams& params, std::uint64_t seed) : params
     if (!(params.terrain_sd_m_per_sqrt_m >= 0.0) || !std::isfinite(params.terrain_sd_m_per_sqrt_m)) {
         throw std::invalid_argument("land wheel: terrain_sd_m_per_sqrt_m must be finite and >= 0");
     }
+    if (!(params.deflection_pct >= 0.0 && params.deflection_pct < 20.0)) {
+        throw std::invalid_argument("land wheel: deflection_pct must be in [0, 20)");
+    }
     if (!(params.terrain_length_m > 0.0) || !std::isfinite(params.terrain_length_m)) {
         throw std::invalid_argument("land wheel: terrain_length_m must be finite and > 0");
     }
@@ -30,9 +33,12 @@ LandWheel::LandWheel(const LandWheelParams& params, std::uint64_t seed) : params
     // A random walk's increment over one cell has sd sigma * sqrt(cell length).
     const double increment_sd_m = params.terrain_sd_m_per_sqrt_m * std::sqrt(kGridStep_m);
     node_travel_m_.reserve(cells + 1);
+    // Nominal-circumference metres per ground metre: slip makes it less, a
+    // deflected (smaller) rolling radius makes it more.
+    const double turns_per_ground_m = (1.0 - slip_fraction_) / (1.0 - params.deflection_pct / 100.0);
     node_travel_m_.push_back(0.0);
     for (std::size_t cell = 0; cell < cells; ++cell) {
-        const double rolled_m = kGridStep_m * (1.0 - slip_fraction_) + increment_sd_m * terrain_random.gaussian();
+        const double rolled_m = kGridStep_m * turns_per_ground_m + increment_sd_m * terrain_random.gaussian();
         // Never backwards: at worst the wheel skids through the cell without turning.
         node_travel_m_.push_back(node_travel_m_.back() + std::max(0.0, rolled_m));
     }

@@ -14,6 +14,7 @@
 #include "emulators/breakpoint_button.h"
 #include "emulators/gnss_g970.h"
 #include "emulators/plant.h"
+#include "emulators/seeded_random.h"
 #include "emulators/wheel_encoder.h"
 #include "harness/metrics.h"
 #include "harness/trace_recorder.h"
@@ -75,6 +76,9 @@ emulators::G970Params gnss_params(const CaseSpec& spec, std::uint64_t seed, doub
     params.talker = talker;
     params.rate_hz = spec.gnss.rate_hz;
     params.latency_s = spec.gnss.latency_s;
+    params.epoch_phase_s =
+        spec.gnss.epoch_phase_s.value_or(emulators::SeededRandom(seed, "gnss_g970.epoch_phase").uniform01() /
+                                         spec.gnss.rate_hz);
     params.fix = to_fix_kind(spec.gnss.fix);
     params.noise_base_m = spec.gnss.noise.base_m;
     params.noise_ppm = spec.gnss.noise.ppm;
@@ -163,6 +167,8 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
         plant_params.start_nozzle_line_along_m = scenario.start_along_m;
         plant_params.wheel.slip_pct = spec.encoder.slip_pct;
         plant_params.wheel.slip_sd_pct = spec.encoder.slip_sd_pct;
+        plant_params.wheel.deflection_pct = spec.encoder.deflection_pct;
+        plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
         plant_params.seed = result.seed;
         const emulators::Plant plant(plant_params);
 

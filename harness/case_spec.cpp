@@ -135,6 +135,9 @@ GnssSpec read_gnss(const YamlSection& section) {
     gnss.talker = section.optional_enum<GnssTalker>("talker", kTalkers, gnss.talker);
     gnss.rate_hz = section.optional_in_range<double>("rate_hz", gnss.rate_hz, Bounds::open_closed(0, 20));
     gnss.latency_s = section.optional_in_range<double>("latency_s", gnss.latency_s, Bounds::closed_open(0, 1));
+    if (section.has("epoch_phase_s")) {
+        gnss.epoch_phase_s = section.required_in_range<double>("epoch_phase_s", Bounds::closed_open(0, 1.0 / gnss.rate_hz));
+    }
     gnss.fix = section.optional_enum<GnssFix>("fix", kFixes, gnss.fix);
 
     const YamlSection noise = section.section("noise");
@@ -173,6 +176,10 @@ EncoderSpec read_encoder(const YamlSection& section) {
     encoder.rate_hz = section.optional_in_range<double>("rate_hz", encoder.rate_hz, Bounds::open_closed(0, 1000));
     encoder.slip_pct = section.optional_in_range<double>("slip_pct", encoder.slip_pct, Bounds::closed(-20, 20));
     encoder.slip_sd_pct = section.optional_in_range<double>("slip_sd_pct", encoder.slip_sd_pct, Bounds::at_least(0));
+    encoder.deflection_pct =
+        section.optional_in_range<double>("deflection_pct", encoder.deflection_pct, Bounds::closed_open(0, 20));
+    encoder.terrain_sd_m_per_sqrt_m = section.optional_in_range<double>(
+        "terrain_sd_m_per_sqrt_m", encoder.terrain_sd_m_per_sqrt_m, Bounds::closed(0, 1));
     return encoder;
 }
 

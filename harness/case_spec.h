@@ -94,7 +94,12 @@ struct GnssDegraded {
 struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
     double rate_hz = 5.0;      // (0, 20]; the G970II runs at 5 Hz
-    double latency_s = 0.02;   // [0, 1): fix epoch -> sentence on the wire
+    double latency_s = 0.02;   // [0, 1): fix epoch -> the epoch's last sentence complete at the controller
+    // Receiver epochs fall at epoch_phase_s + k / rate_hz of simulated time. The
+    // receiver's epoch grid has nothing to do with where the sprayer is, so when
+    // the file does not fix it, it is drawn from the seed in [0, 1 / rate_hz):
+    // runs with different seeds meet the breakpoint at different epoch phases.
+    std::optional<double> epoch_phase_s;
     GnssFix fix = GnssFix::rtk_fixed;
     GnssNoiseSpec noise;
     std::vector<GnssDropout> dropouts;  // may overlap each other; not checked
@@ -107,6 +112,8 @@ struct EncoderSpec {
     double rate_hz = 100.0;               // count publication rate, (0, 1000]
     double slip_pct = 0.0;                // mean wheel slip, [-20, 20]; ideal wheel unless the case says so
     double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), >= 0
+    double deflection_pct = 0.0;          // loaded tyre: rolling radius below nominal, [0, 20) (emulators/land_wheel.h)
+    double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 
 struct ControllerSpec {

@@ -272,7 +272,7 @@ const std::vector<BrokenFile>& broken_files() {
          minimal_with_line(5, "vehical:"), "5:1: vehical:", "did you mean 'vehicle'?"},
         {"unknown key: nothing close, so the known keys are listed",
          std::string(kMinimalCase) + "gnss: { colour: red }\n", "8:9: gnss.colour:",
-         "known keys here: degraded, dropouts, fix, latency_s, noise, rate_hz, talker"},
+         "known keys here: degraded, dropouts, epoch_phase_s, fix, latency_s, noise, rate_hz, talker"},
         {"wrong type: a word where a number belongs",
          minimal_with_line(6, "  speed_km_h: fast"), "6:15: vehicle.speed_km_h:", "expected a number, got 'fast'"},
         {"wrong type: a quoted number",
