@@ -8,6 +8,10 @@ BreakpointLocator::BreakpointLocator(const ControllerConfig& config)
     : config_(config),
       l4_m_(antenna_to_nozzle_m(config.l1_m, config.l2_m, config.l3_m, config.linkage_rise_m)) {}
 
+void BreakpointLocator::set_linkage_rise_m(double linkage_rise_m) {
+    l4_m_ = antenna_to_nozzle_m(config_.l1_m, config_.l2_m, config_.l3_m, linkage_rise_m);
+}
+
 void BreakpointLocator::set_target(std::optional<StoredBreakpoint> breakpoint) {
     target_ = std::move(breakpoint);
     armed_ = false;

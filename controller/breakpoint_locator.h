@@ -40,6 +40,10 @@ public:
     LocatorEvent on_encoder(std::uint32_t count);
 
     double l4_m() const { return l4_m_; }
+    // The boom moved: Eq. 6 again with the pull-wire sensor's linkage rise h.
+    void set_linkage_rise_m(double linkage_rise_m);
+    // A stored breakpoint is ahead and was seen approaching it (within the window).
+    bool armed() const { return armed_; }
     bool odometer_active() const { return odometer_base_count_.has_value(); }
     // Latest estimate of the nozzle line's remaining distance to the breakpoint.
     std::optional<double> nozzle_to_breakpoint_m() const { return nozzle_to_go_m_; }

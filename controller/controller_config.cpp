@@ -6,6 +6,84 @@
 
 namespace rig::controller {
 
+namespace {
+
+void read_flow_control(const YamlSection& section, ControllerConfig& config) {
+    config.target_flow_l_min =
+        section.optional_in_range("target_flow_l_min", config.target_flow_l_min, Bounds::open_closed(0.0, 250.0));
+    config.section_count = section.optional_in_range("section_count", config.section_count, Bounds::closed(1, 16));
+    config.min_spray_speed_km_h =
+        section.optional_in_range("min_spray_speed_km_h", config.min_spray_speed_km_h, Bounds::closed(0.0, 20.0));
+    config.hysteresis_compensation = section.optional<bool>("hysteresis_compensation", config.hysteresis_compensation);
+    config.assumed_flow_adjust_s =
+        section.optional_in_range("assumed_flow_adjust_s", config.assumed_flow_adjust_s, Bounds::closed(0.0, 30.0));
+    config.assumed_spray_delay_s =
+        section.optional_in_range("assumed_spray_delay_s", config.assumed_spray_delay_s, Bounds::closed(0.0, 5.0));
+
+    const YamlSection pid = section.section("pid");
+    config.pid.kp = pid.optional_in_range("kp", config.pid.kp, Bounds::closed(0.0, 100.0));
+    config.pid.ki = pid.optional_in_range("ki", config.pid.ki, Bounds::closed(0.0, 100.0));
+    config.pid.kd = pid.optional_in_range("kd", config.pid.kd, Bounds::closed(0.0, 100.0));
+    config.pid_period_s = pid.optional_in_range("period_s", config.pid_period_s, Bounds::closed(0.01, 5.0));
+    config.pid_integral_limit_l_min =
+        pid.optional_in_range("integral_limit_l_min", config.pid_integral_limit_l_min, Bounds::open_closed(0.0, 250.0));
+    config.flow_established_change_pct = pid.optional_in_range(
+        "established_change_pct", config.flow_established_change_pct, Bounds::open_closed(0.0, 100.0));
+    pid.finish();
+
+    config.on_target_band_pct =
+        section.optional_in_range("on_target_band_pct", config.on_target_band_pct, Bounds::open_closed(0.0, 50.0));
+    config.on_target_hold_s =
+        section.optional_in_range("on_target_hold_s", config.on_target_hold_s, Bounds::closed(0.0, 30.0));
+
+    const YamlSection meter = section.section("flow_meter");
+    config.flow_meter_pulses_per_l =
+        meter.optional_in_range("pulses_per_l", config.flow_meter_pulses_per_l, Bounds::open_closed(0.0, 100000.0));
+    config.flow_window_s = meter.optional_in_range("window_s", config.flow_window_s, Bounds::closed(0.05, 10.0));
+    meter.finish();
+
+    const YamlSection pump = section.section("pump_sensor");
+    config.pump_sensor_full_scale_m3_h = pump.optional_in_range("full_scale_m3_h", config.pump_sensor_full_scale_m3_h,
+                                                                Bounds::open_closed(0.0, 1000.0));
+    config.pump_sensor_span_v = pump.optional_in_range("span_v", config.pump_sensor_span_v, Bounds::open_closed(0.0, 10.0));
+    config.pump_flow_smoothing_s =
+        pump.optional_in_range("smoothing_s", config.pump_flow_smoothing_s, Bounds::closed(0.0, 10.0));
+    pump.finish();
+
+    const YamlSection height = section.section("boom_height_sensor");
+    config.boom_height_range_m =
+        height.optional_in_range("range_m", config.boom_height_range_m, Bounds::open_closed(0.0, 10.0));
+    config.boom_height_span_v = height.optional_in_range("span_v", config.boom_height_span_v, Bounds::open_closed(0.0, 10.0));
+    height.finish();
+
+    const YamlSection valve = section.section("valve");
+    config.valve.travel_s = valve.optional_in_range("travel_s", config.valve.travel_s, Bounds::open_closed(0.0, 120.0));
+    config.valve.start_delay_s =
+        valve.optional_in_range("start_delay_s", config.valve.start_delay_s, Bounds::closed(0.0, 1.0));
+    config.valve.backlash_pct = valve.optional_in_range("backlash_pct", config.valve.backlash_pct, Bounds::closed(0.0, 20.0));
+    config.valve.reset_open_s = valve.optional_in_range("reset_open_s", config.valve.reset_open_s, Bounds::closed(0.0, 120.0));
+    config.valve.reset_back_s = valve.optional_in_range("reset_back_s", config.valve.reset_back_s, Bounds::closed(0.0, 120.0));
+    config.valve.deadband_pct = valve.optional_in_range("deadband_pct", config.valve.deadband_pct, Bounds::closed(0.0, 10.0));
+    const std::vector<YamlSection> lines = valve.list("calibration");
+    if (!lines.empty()) {
+        config.calibration.clear();
+        for (const YamlSection& line : lines) {
+            config.calibration.push_back(CalibratedOpening{
+                line.required_in_range<double>("opening_pct", Bounds::closed(0.0, 100.0)),
+                line.required_in_range<double>("slope", Bounds::closed(-10.0, 10.0)),
+                line.required_in_range<double>("intercept_l_min", Bounds::closed(-250.0, 250.0))});
+        }
+    }
+    valve.finish();
+    try {
+        ValveCalibration{config.calibration};
+    } catch (const std::invalid_argument& error) {
+        valve.fail("calibration", error.what());
+    }
+}
+
+}  // namespace
+
 ControllerConfig parse_controller_config(const YamlSection& section) {
     ControllerConfig config;
     section.allow("command");
@@ -41,6 +119,7 @@ ControllerConfig parse_controller_config(const YamlSection& section) {
         section.optional_in_range("status_rate_hz", config.status_rate_hz, Bounds::open_closed(0.0, 1000.0));
     config.breakpoint_store_file = section.optional<std::string>("breakpoint_store_file", config.breakpoint_store_file);
     if (config.breakpoint_store_file.empty()) section.fail("breakpoint_store_file", "must not be empty");
+    read_flow_control(section, config);
     section.finish();
     return config;
 }

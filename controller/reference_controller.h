@@ -1,22 +1,24 @@
 #pragma once
-// The reference controller under test: what an STM32 board running the paper's
-// firmware does, as a rig node. It reads only device topics (NMEA text, encoder
-// count, button level), converts them itself (Eq. 3-6), and publishes its status
-// and breakpoint events. It never sees truth.
+// The reference controller under test as a rig node on DDS: what an STM32 board
+// running the paper's firmware does, with DDS topics as its wires. It reads only
+// device topics, hands them to the firmware logic (controller/spray_controller.h),
+// and publishes the actuator commands, its breakpoint events and its status. It
+// never sees truth.
 //
 // Subscriptions: device/gnss/nmea, device/wheel_encoder/count,
-//                device/breakpoint_button/level
-// Publications:  controller/status, controller/breakpoint_event
-#include <deque>
+//                device/main_flow_meter/count, device/pump_flow_sensor/voltage,
+//                device/boom_height_sensor/voltage, device/breakpoint_button/level,
+//                device/spray_switch/level
+// Publications:  actuator/ball_valve/relays, actuator/section_valves/open,
+//                actuator/unloading_valve/open, controller/status,
+//                controller/breakpoint_event
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 
-#include "controller/breakpoint_locator.h"
-#include "controller/breakpoint_store.h"
 #include "controller/controller_config.h"
-#include "controller/nmea_parser.h"
+#include "controller/spray_controller.h"
 #include "rig/dds_context.h"
 #include "rig/node.h"
 
@@ -32,40 +34,27 @@ public:
     bool has_unread_input() const override;
 
 private:
-    void handle_sentence(const std::string& line, TimeNs now_ns);
-    void handle_encoder(std::uint32_t count, TimeNs now_ns);
-    void handle_button(bool pressed, TimeNs now_ns);
-    void store_breakpoint_here(TimeNs now_ns);
-    void on_breakpoint_reached(TimeNs now_ns);
-    void select_target();
-    void publish_event(msg::BreakpointEventKind kind, const StoredBreakpoint& breakpoint, TimeNs now_ns);
-    void publish_status(TimeNs now_ns);
-    double speed_m_s() const;
+    void publish_changed_actuators();
 
     // --- subscriptions
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
     std::unique_ptr<Reader<msg::EncoderCount>> encoder_reader_;
-    std::unique_ptr<Reader<msg::ButtonLevel>> button_reader_;
+    std::unique_ptr<Reader<msg::FlowMeterCount>> flow_meter_reader_;
+    std::unique_ptr<Reader<msg::AnalogInput>> pump_sensor_reader_;
+    std::unique_ptr<Reader<msg::AnalogInput>> boom_height_reader_;
+    std::unique_ptr<Reader<msg::SwitchLevel>> button_reader_;
+    std::unique_ptr<Reader<msg::SwitchLevel>> spray_switch_reader_;
     // --- publications
+    std::unique_ptr<Writer<msg::BallValveRelays>> relays_writer_;
+    std::unique_ptr<Writer<msg::SectionValves>> sections_writer_;
+    std::unique_ptr<Writer<msg::UnloadingValve>> unloading_writer_;
     std::unique_ptr<Writer<msg::ControllerStatus>> status_writer_;
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
 
     std::string name_;
     ControllerConfig config_;
-    BreakpointStore store_;
-    BreakpointLocator locator_;
-
-    // Latest GNSS state, assembled from GGA (position, quality) and RMC (course).
-    std::optional<FixInput> last_fix_;
-    std::optional<double> last_course_deg_;  // kept while standing (RMC course is empty then)
-    int last_quality_ = 0;
-    std::uint32_t rejected_sentences_ = 0;
-
-    // Encoder samples within the Eq. 5 speed window: (time, count).
-    std::deque<std::pair<TimeNs, std::uint32_t>> encoder_window_;
-    std::optional<std::uint32_t> latest_count_;
-    bool button_pressed_ = false;
-
+    SprayController firmware_;
+    std::optional<io::ActuatorCommands> published_;  // what the actuator topics last said
     TimeNs status_period_ns_;
     TimeNs next_status_ns_ = 0;
 };

@@ -29,6 +29,7 @@ msg::VehicleTruth Plant::truth_at(TimeNs t) const {
     truth.l4_m(params_.boom.l4_m());
     truth.boom_height_m(params_.boom.linkage_rise_m);
     truth.wheel_travel_m(wheel_.wheel_travel_m(state.odometer_distance_m));
+    truth.pass_index(static_cast<std::uint16_t>(vehicle_.pass_index_at(ns_to_seconds(t))));
     return truth;
 }
 
@@ -41,7 +42,7 @@ void PlantNode::configure(DdsContext& dds) {
 
 TimeNs PlantNode::step(TimeNs now_ns) {
     truth_writer_->publish(plant_.truth_at(now_ns));
-    return (now_ns / period_ns_ + 1) * period_ns_;
+    return next_period_boundary(now_ns, period_ns_);
 }
 
 }  // namespace rig::emulators

@@ -122,6 +122,24 @@ VehiclePlant::Kinematics VehiclePlant::drive_kinematics(const Segment& drive, do
     return {drive.end_along_m, 0.0, 0.0};
 }
 
+int VehiclePlant::pass_index_at(double t_s) const {
+    int pass = 0;
+    for (const Segment& segment : segments_) {
+        if (segment.start_s > t_s) break;
+        if (segment.kind == Segment::Kind::reposition) ++pass;
+    }
+    return pass;
+}
+
+double VehiclePlant::pass_start_s(int pass) const {
+    if (pass == 0) return 0.0;
+    int seen = 0;
+    for (const Segment& segment : segments_) {
+        if (segment.kind == Segment::Kind::reposition && ++seen == pass) return segment.start_s;
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+}
+
 double VehiclePlant::drive_time_for(const Segment& drive, double covered_m) {
     const double accel = drive.accel_m_s2;
     const double length_m = drive.end_along_m - drive.start_along_m;

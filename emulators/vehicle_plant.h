@@ -78,6 +78,11 @@ public:
     VehicleState state_at(double t_s) const;
     // When the last phase ends.
     double end_time_s() const;
+    // Which pass the vehicle is on at t_s: 0 until the first reposition (headland
+    // turn), then 1, and so on. Spray on the ground is booked per pass.
+    int pass_index_at(double t_s) const;
+    // Start time of pass `pass` (0 for the first), NaN if the route has no such pass.
+    double pass_start_s(int pass) const;
     // The first time t >= after_s, inside a drive phase, at which the nozzle line
     // is at along_m, solved exactly from the phase's kinematics; NaN if it never
     // is. A drive that starts or ends exactly at along_m counts (its start or end

@@ -24,7 +24,7 @@ TimeNs WheelEncoder::step(TimeNs now_ns) {
     msg::EncoderCount count;
     count.count_pulses(count_at(now_ns));
     count_writer_->publish(count);
-    return (now_ns / period_ns_ + 1) * period_ns_;
+    return next_period_boundary(now_ns, period_ns_);
 }
 
 }  // namespace rig::emulators

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -11,13 +12,19 @@
 #include <yaml-cpp/yaml.h>
 
 #include "controller/controller_config.h"
-#include "emulators/breakpoint_button.h"
+#include "emulators/boom_height_sensor.h"
+#include "emulators/flow_meter_kf11.h"
+#include "emulators/panel_switch.h"
+#include "emulators/pump_flow_sensor.h"
+#include "emulators/spray_circuit.h"
+#include "emulators/spray_circuit_node.h"
 #include "emulators/gnss_g970.h"
 #include "emulators/plant.h"
 #include "emulators/seeded_random.h"
 #include "emulators/wheel_encoder.h"
 #include "harness/metrics.h"
 #include "harness/trace_recorder.h"
+#include "idl/topics.h"
 #include "rig/child_process.h"
 #include "rig/domain_lease.h"
 #include "rig/lockstep.h"
@@ -26,37 +33,79 @@ namespace rig::harness {
 
 namespace {
 
-// How the case's scenario becomes a route (seed 000 sec. 2.5.1): a first pass
-// sprays up to the breakpoint and stops there; the operator presses the button;
-// the sprayer turns at the headland (not simulated: it reappears at start_m) and
-// approaches the breakpoint again, driving `overrun_m` past it.
-constexpr double kFirstPassLengthM = 10.0;
+// How the case's scenario becomes a route (seed 000 sec. 2.5.1, 2.5.2):
+//   breakpoint_*: the first pass drives first_pass_m up to the breakpoint and
+//   stops with the nozzle line on it; the operator presses the button; the
+//   sprayer turns at the headland (not simulated: it reappears at start_m) and
+//   approaches the breakpoint again, driving overrun_m past it.
+//   static_flow: the sprayer stands at the breakpoint; the spray switch goes on
+//   at spray_on_at_s for spray_for_s (sec. 2.4's static tests).
 constexpr double kStandAfterButtonS = 1.0;
 constexpr double kStandBeforeApproachS = 2.0;
-constexpr double kTruthRateHz = 20.0;
+constexpr double kStandAfterStaticS = 3.0;
+constexpr double kVehicleTruthRateHz = 20.0;
+constexpr double kHydraulicsTruthRateHz = 100.0;
+constexpr double kForeverS = 1e6;
 
-struct Scenario {
+struct ScenarioPlan {
     std::vector<emulators::RoutePhase> route;
     double start_along_m = 0.0;  // nozzle line at t = 0
-    double button_at_s = 0.0;
+    std::vector<emulators::SwitchClosure> button;
+    std::vector<emulators::SwitchClosure> spray_switch;
     double approach_starts_s = 0.0;
 };
 
-Scenario build_scenario(const CaseSpec& spec, const emulators::BoomGeometry& boom) {
-    const double cruise_m_s = spec.vehicle.speed_km_h / 3.6;
+ScenarioPlan build_scenario(const CaseSpec& spec, const emulators::BoomGeometry& boom) {
     const double bp = spec.breakpoint.along_m;
-    Scenario scenario;
-    scenario.start_along_m = bp - kFirstPassLengthM;
+    ScenarioPlan scenario;
+    if (spec.scenario == Scenario::static_flow) {
+        scenario.start_along_m = bp;
+        scenario.route.push_back(emulators::StandPhase{spec.static_flow.spray_on_at_s + spec.static_flow.spray_for_s +
+                                                       kStandAfterStaticS});
+        scenario.spray_switch.push_back({spec.static_flow.spray_on_at_s, spec.static_flow.spray_for_s});
+        return scenario;
+    }
+    const double cruise_m_s = spec.vehicle.speed_km_h / 3.6;
+    scenario.start_along_m = bp - spec.vehicle.first_pass_m;
+    if (spec.vehicle.wait_before_first_pass_s > 0.0) {
+        scenario.route.push_back(emulators::StandPhase{spec.vehicle.wait_before_first_pass_s});
+    }
     scenario.route.push_back(emulators::DrivePhase{bp, cruise_m_s, spec.vehicle.accel_m_s2});
     const double stop_s = emulators::VehiclePlant(scenario.route, boom, scenario.start_along_m).end_time_s();
-    scenario.button_at_s = stop_s + spec.breakpoint.button_at_s;
-    scenario.approach_starts_s = scenario.button_at_s + kStandAfterButtonS;
+    const double button_at_s = stop_s + spec.breakpoint.button_at_s;
+    scenario.button.push_back({button_at_s, 0.2});
+    scenario.approach_starts_s = button_at_s + kStandAfterButtonS;
     scenario.route.push_back(emulators::StandPhase{spec.breakpoint.button_at_s + kStandAfterButtonS});
     scenario.route.push_back(emulators::RepositionPhase{spec.vehicle.start_m});
     scenario.route.push_back(emulators::StandPhase{kStandBeforeApproachS});
     scenario.route.push_back(
         emulators::DrivePhase{bp + spec.vehicle.overrun_m, cruise_m_s, spec.vehicle.accel_m_s2});
+    if (spec.scenario == Scenario::breakpoint_continuation) scenario.spray_switch.push_back({0.0, kForeverS});
     return scenario;
+}
+
+emulators::SprayCircuitParams circuit_params(const CaseSpec& spec, double grid_from_m, double grid_to_m) {
+    const HydraulicsSpec& h = spec.hydraulics;
+    emulators::SprayCircuitParams params;
+    params.pump_flow_l_min = h.pump_flow_l_min;
+    params.pump_pulsation_pct = h.pump_pulsation_pct;
+    params.pump_pulsation_hz = h.pump_pulsation_hz;
+    params.valve = emulators::BallValveParams{h.valve_travel_s, h.valve_motor_start_delay_s, h.valve_backlash_pct,
+                                              h.valve_initial_opening_pct};
+    params.flow_map.interpolation_bulge_pct = h.interpolation_bulge_pct;
+    params.flow_map.calibration_drift_pct = h.calibration_drift_pct;
+    params.pipeline_time_constant_s = h.pipeline_time_constant_s;
+    params.section_nozzles = h.section_nozzles;
+    params.boom_width_m = h.boom_width_m;
+    params.section_valve_open_s = h.section_valve_open_s;
+    params.section_valve_close_s = h.section_valve_close_s;
+    params.droplet_fall_s = h.droplet_fall_s;
+    params.min_nozzle_flow_l_min = h.min_nozzle_flow_l_min;
+    params.deposition.from_along_m = grid_from_m;
+    params.deposition.to_along_m = grid_to_m;
+    params.deposition.cell_along_m = spec.deposition.cell_m;
+    params.deposition.footprint_along_m = spec.deposition.footprint_m;
+    return params;
 }
 
 emulators::GnssFixKind to_fix_kind(GnssFix fix) {
@@ -142,6 +191,72 @@ void validate_for_run(const CaseSpec& spec, const RunOptions& /*options*/) {
     }
 }
 
+namespace {
+
+// The section-valve commands in the trace, as (time, mask).
+std::vector<std::pair<TimeNs, std::uint16_t>> section_commands(const TraceRecorder& trace) {
+    std::vector<std::pair<TimeNs, std::uint16_t>> commands;
+    for (const auto& [t, sample] : trace.samples(topics::kSectionValves)) {
+        commands.emplace_back(t, sample.at("open_mask").get<std::uint16_t>());
+    }
+    return commands;
+}
+
+// The regulation episode the flow metrics judge: in a continuation, the first
+// opening after the headland turn; in a static test, the first opening.
+std::optional<FlowEpisode> judged_episode(const TraceRecorder& trace, TimeNs from_ns, TimeNs end_ns) {
+    std::optional<FlowEpisode> episode;
+    std::uint16_t previous = 0;
+    for (const auto& [t, mask] : section_commands(trace)) {
+        if (!episode && t >= from_ns && mask != 0 && previous == 0) episode = FlowEpisode{t, end_ns};
+        if (episode && t > episode->open_command_ns && mask == 0) {
+            episode->end_ns = t;
+            break;
+        }
+        previous = mask;
+    }
+    return episode;
+}
+
+std::vector<FlowSample> main_flow_samples(const TraceRecorder& trace) {
+    std::vector<FlowSample> samples;
+    for (const auto& [t, sample] : trace.samples(topics::kHydraulicsTruth)) {
+        samples.push_back(FlowSample{t, sample.at("main_flow_l_min").get<double>()});
+    }
+    return samples;
+}
+
+// Table 1 from truth: section-open command -> valves open -> first droplets land.
+void add_spray_timing_metrics(const TraceRecorder& trace, const emulators::SprayCircuit& circuit,
+                              std::map<std::string, double>& metrics) {
+    const auto commands = section_commands(trace);
+    const auto first_open = std::find_if(commands.begin(), commands.end(), [](const auto& c) { return c.second != 0; });
+    if (first_open == commands.end()) return;
+    for (const auto& [t, sample] : trace.samples(topics::kHydraulicsTruth)) {
+        if (t >= first_open->first && sample.at("sections_spraying_mask").get<int>() != 0) {
+            metrics["section_valve_open_delay_s"] = ns_to_seconds(t - first_open->first);
+            break;
+        }
+    }
+    for (const emulators::LandingEdge& edge : circuit.landing_edges()) {
+        if (edge.landing && edge.at_ns >= first_open->first) {
+            metrics["spray_landing_delay_s"] = ns_to_seconds(edge.at_ns - first_open->first);
+            break;
+        }
+    }
+}
+
+DoseProfile dose_profile(const emulators::DepositionGrid& grid) {
+    DoseProfile profile;
+    profile.first_row_centre_m = grid.row_centre_m(0);
+    profile.row_m = grid.params().cell_along_m;
+    profile.first_pass = grid.row_mean_dose_ul_cm2(0);
+    profile.continuation = grid.row_mean_dose_ul_cm2(1);
+    return profile;
+}
+
+}  // namespace
+
 CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
     const WallStopwatch wall;
     CaseResult result;
@@ -162,7 +277,7 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
         plant_params.heading_deg = spec.field.heading_deg;
         plant_params.boom = emulators::BoomGeometry{spec.boom.l1_m, spec.boom.l2_m, spec.boom.l3_m,
                                                     spec.boom.linkage_rise_m};
-        const Scenario scenario = build_scenario(spec, plant_params.boom);
+        const ScenarioPlan scenario = build_scenario(spec, plant_params.boom);
         plant_params.route = scenario.route;
         plant_params.start_nozzle_line_along_m = scenario.start_along_m;
         plant_params.wheel.slip_pct = spec.encoder.slip_pct;
@@ -171,10 +286,17 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
         plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
         plant_params.seed = result.seed;
         const emulators::Plant plant(plant_params);
+        const bool static_test = spec.scenario == Scenario::static_flow;
 
         const double crossing_s =
-            plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m, scenario.approach_starts_s);
+            static_test ? std::numeric_limits<double>::quiet_NaN()
+                        : plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m,
+                                                                        scenario.approach_starts_s);
         const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
+        // The deposition grid spans everything the boom can reach, with a margin.
+        const double grid_from_m = std::min(scenario.start_along_m, spec.vehicle.start_m) - 5.0;
+        const double grid_to_m = spec.breakpoint.along_m + spec.vehicle.overrun_m + 5.0;
+        emulators::SprayCircuit circuit(plant, circuit_params(spec, grid_from_m, grid_to_m));
 
         // The controller under test, in its own process on this run's own domain.
         const DomainLease lease = DomainLease::acquire();
@@ -193,26 +315,38 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
         DdsContext dds(lease.domain_id(), "harness");
         TraceRecorder trace(dds, case_dir / "trace.sqlite");
         // Nodes hold DDS writers, so they are declared after (and destroyed before) the context.
+        emulators::PlantNode plant_node(plant, kVehicleTruthRateHz);
+        emulators::SprayCircuitNode circuit_node(circuit, kHydraulicsTruthRateHz);
         emulators::GnssG970 gnss(plant, gnss_params(spec, result.seed, crossing_s));
         emulators::WheelEncoder encoder(
             plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev, spec.encoder.wheel_diameter_m,
                                                  spec.encoder.rate_hz});
-        emulators::BreakpointButton button({emulators::ButtonPress{scenario.button_at_s, 0.2}});
-        emulators::PlantNode plant_node(plant, kTruthRateHz);
+        emulators::FlowMeterKf11 flow_meter(
+            circuit, emulators::Kf11Params{spec.flow_meter.pulses_per_l, spec.flow_meter.k_factor_error_pct, 0.27,
+                                           14.14, spec.flow_meter.rate_hz});
+        emulators::PumpFlowSensor pump_sensor(
+            circuit, emulators::PumpFlowSensorParams{spec.pump_sensor.full_scale_m3_h, spec.pump_sensor.noise_mv,
+                                                     spec.pump_sensor.offset_ma, spec.pump_sensor.rate_hz, result.seed});
+        emulators::BoomHeightSensor boom_height(
+            plant, emulators::BoomHeightSensorParams{spec.boom_height_sensor.range_m, spec.boom_height_sensor.rate_hz});
+        emulators::PanelSwitch button("breakpoint_button", topics::kBreakpointButton, scenario.button);
+        emulators::PanelSwitch spray_switch("spray_switch", topics::kSpraySwitch, scenario.spray_switch);
 
         trace.set_meta("case", spec.name);
         trace.set_meta("case_file", spec.source_path.string());
+        trace.set_meta("scenario", std::string(to_string(spec.scenario)));
         trace.set_meta("seed", std::to_string(result.seed));
         trace.set_meta("controller_command", controller.command_line());
 
         LockstepTimeouts timeouts;
         timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
         LockstepMaster master(dds, timeouts);
-        // Local nodes step in this order each instant: plant truth first.
-        master.add_local_node(plant_node);
-        master.add_local_node(gnss);
-        master.add_local_node(encoder);
-        master.add_local_node(button);
+        // Local nodes step in this order each instant: plant truth and the spray
+        // circuit (which takes the actuator commands) before the devices sample them.
+        for (Node* node : std::initializer_list<Node*>{&plant_node, &circuit_node, &gnss, &encoder, &flow_meter,
+                                                       &pump_sensor, &boom_height, &button, &spray_switch}) {
+            master.add_local_node(*node);
+        }
         master.add_remote_node("controller", [&controller] { return controller.exit_description(); });
         master.set_after_round([&trace](TimeNs t, int round) { trace.drain(t, round); });
 
@@ -235,11 +369,43 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
             controller.stop(std::chrono::milliseconds(500));
             throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
         }
+        circuit.advance_to(end_ns);
 
+        trace.record_deposition(circuit.deposition());
         result.trace_sha256 = trace.finish();
         result.trace_path = (case_dir / "trace.sqlite").string();
         result.sim_seconds = ns_to_seconds(end_ns);
-        result.metrics = breakpoint_metrics(trace, plant, spec.breakpoint.along_m);
+
+        if (!static_test) {
+            result.metrics = breakpoint_metrics(trace, plant, spec.breakpoint.along_m);
+        }
+        if (spec.scenario != Scenario::breakpoint_identification) {
+            const double target = spec.controller.target_flow_l_min;
+            const TimeNs judged_from_ns =
+                static_test ? 0 : seconds_to_ns(plant.vehicle().pass_start_s(plant.vehicle().pass_index_at(1e9)));
+            if (const auto episode = judged_episode(trace, judged_from_ns, end_ns)) {
+                for (const auto& [name, value] : flow_metrics(main_flow_samples(trace), *episode, target)) {
+                    result.metrics[name] = value;
+                }
+                if (!static_test) {
+                    // Where the flow adjustment began, before the breakpoint (paper: 1.70 / 2.55 / 3.45 m).
+                    const double open_at_m = plant.truth_at(episode->open_command_ns).nozzle_line_along_m();
+                    result.metrics["flow_adjust_start_before_breakpoint_m"] = spec.breakpoint.along_m - open_at_m;
+                }
+            }
+            add_spray_timing_metrics(trace, circuit, result.metrics);
+        }
+        if (spec.scenario == Scenario::breakpoint_continuation) {
+            DepositionJudging judging;
+            judging.nominal_dose_ul_cm2 = spec.controller.target_flow_l_min / 60.0 /
+                                          (spec.vehicle.speed_km_h / 3.6 * spec.hydraulics.boom_width_m) * 100.0;
+            judging.sprayed_fraction = spec.deposition.sprayed_fraction;
+            judging.cv_row_m = spec.deposition.cv_row_m;
+            judging.cv_window_m = spec.deposition.cv_window_m;
+            const DepositionResult deposition =
+                deposition_metrics(dose_profile(circuit.deposition()), judging, spec.breakpoint.along_m);
+            for (const auto& [name, value] : deposition.metrics) result.metrics[name] = value;
+        }
     } catch (const std::exception& error) {
         result.error = error.what();
     }

@@ -14,6 +14,11 @@ constexpr EnumChoice<RunMode> kRunModes[] = {
     {"lockstep", RunMode::lockstep},
     {"realtime", RunMode::realtime},
 };
+constexpr EnumChoice<Scenario> kScenarios[] = {
+    {"breakpoint_identification", Scenario::breakpoint_identification},
+    {"breakpoint_continuation", Scenario::breakpoint_continuation},
+    {"static_flow", Scenario::static_flow},
+};
 constexpr EnumChoice<GnssTalker> kTalkers[] = {
     {"GP", GnssTalker::gp},
     {"GN", GnssTalker::gn},
@@ -104,12 +109,22 @@ FieldSpec read_field(const YamlSection& section) {
     return field;
 }
 
-VehicleSpec read_vehicle(const YamlSection& section) {
+// A static test has the vehicle standing: then its section is optional.
+VehicleSpec read_vehicle(const YamlSection& section, bool standing) {
     VehicleSpec vehicle;
+    if (standing) {
+        vehicle.speed_km_h = section.optional_in_range<double>("speed_km_h", 0.0, Bounds::closed(0, 30));
+        vehicle.start_m = section.optional<double>("start_m", 0.0);
+        return vehicle;
+    }
     vehicle.speed_km_h = section.required_in_range<double>("speed_km_h", Bounds::open_closed(0, 30));
     vehicle.accel_m_s2 = section.optional_in_range<double>("accel_m_s2", vehicle.accel_m_s2, Bounds::open_closed(0, 5));
     vehicle.start_m = section.required<double>("start_m");
     vehicle.overrun_m = section.optional_in_range<double>("overrun_m", vehicle.overrun_m, Bounds::at_least(0));
+    vehicle.first_pass_m =
+        section.optional_in_range<double>("first_pass_m", vehicle.first_pass_m, Bounds::open_closed(0, 1000));
+    vehicle.wait_before_first_pass_s = section.optional_in_range<double>(
+        "wait_before_first_pass_s", vehicle.wait_before_first_pass_s, Bounds::closed(0, 600));
     return vehicle;
 }
 
@@ -183,6 +198,103 @@ EncoderSpec read_encoder(const YamlSection& section) {
     return encoder;
 }
 
+HydraulicsSpec read_hydraulics(const YamlSection& section) {
+    HydraulicsSpec h;
+    h.pump_flow_l_min = section.optional_in_range<double>("pump_flow_l_min", h.pump_flow_l_min, Bounds::open_closed(0, 200));
+    h.pump_pulsation_pct =
+        section.optional_in_range<double>("pump_pulsation_pct", h.pump_pulsation_pct, Bounds::closed(0, 50));
+    h.pump_pulsation_hz =
+        section.optional_in_range<double>("pump_pulsation_hz", h.pump_pulsation_hz, Bounds::open_closed(0, 500));
+    h.pipeline_time_constant_s = section.optional_in_range<double>("pipeline_time_constant_s",
+                                                                   h.pipeline_time_constant_s, Bounds::open_closed(0, 10));
+    const YamlSection valve = section.section("valve");
+    h.valve_travel_s = valve.optional_in_range<double>("travel_s", h.valve_travel_s, Bounds::open_closed(0, 120));
+    h.valve_backlash_pct = valve.optional_in_range<double>("backlash_pct", h.valve_backlash_pct, Bounds::closed(0, 20));
+    h.valve_motor_start_delay_s =
+        valve.optional_in_range<double>("motor_start_delay_s", h.valve_motor_start_delay_s, Bounds::closed(0, 1));
+    h.valve_initial_opening_pct =
+        valve.optional_in_range<double>("initial_opening_pct", h.valve_initial_opening_pct, Bounds::closed(0, 100));
+    const YamlSection map = section.section("flow_map");
+    h.interpolation_bulge_pct =
+        map.optional_in_range<double>("interpolation_bulge_pct", h.interpolation_bulge_pct, Bounds::closed(-20, 20));
+    h.calibration_drift_pct =
+        map.optional_in_range<double>("calibration_drift_pct", h.calibration_drift_pct, Bounds::closed(-50, 50));
+    if (section.has("section_nozzles")) {
+        h.section_nozzles.clear();
+        const std::vector<std::string> counts = section.string_list("section_nozzles");
+        for (std::size_t i = 0; i < counts.size(); ++i) {
+            int nozzles = 0;
+            const auto result = std::from_chars(counts[i].data(), counts[i].data() + counts[i].size(), nozzles);
+            if (result.ec != std::errc{} || result.ptr != counts[i].data() + counts[i].size() || nozzles < 1 ||
+                nozzles > 64) {
+                throw ConfigError(section.item_location("section_nozzles", i),
+                                  "a section's nozzle count must be a whole number in [1, 64], got '" + counts[i] + "'");
+            }
+            h.section_nozzles.push_back(nozzles);
+        }
+        if (h.section_nozzles.empty() || h.section_nozzles.size() > 8) {
+            section.fail("section_nozzles", "must list 1 to 8 sections");
+        }
+    }
+    h.boom_width_m = section.optional_in_range<double>("boom_width_m", h.boom_width_m, Bounds::open_closed(0, 60));
+    h.section_valve_open_s =
+        section.optional_in_range<double>("section_valve_open_s", h.section_valve_open_s, Bounds::closed(0, 5));
+    h.section_valve_close_s =
+        section.optional_in_range<double>("section_valve_close_s", h.section_valve_close_s, Bounds::closed(0, 5));
+    h.droplet_fall_s = section.optional_in_range<double>("droplet_fall_s", h.droplet_fall_s, Bounds::closed(0, 2));
+    h.min_nozzle_flow_l_min =
+        section.optional_in_range<double>("min_nozzle_flow_l_min", h.min_nozzle_flow_l_min, Bounds::open_closed(0, 20));
+    return h;
+}
+
+FlowMeterSpec read_flow_meter(const YamlSection& section) {
+    FlowMeterSpec meter;
+    meter.pulses_per_l = section.optional_in_range<double>("pulses_per_l", meter.pulses_per_l, Bounds::open_closed(0, 1e5));
+    meter.k_factor_error_pct =
+        section.optional_in_range<double>("k_factor_error_pct", meter.k_factor_error_pct, Bounds::closed(-50, 50));
+    meter.rate_hz = section.optional_in_range<double>("rate_hz", meter.rate_hz, Bounds::open_closed(0, 1000));
+    return meter;
+}
+
+PumpSensorSpec read_pump_sensor(const YamlSection& section) {
+    PumpSensorSpec sensor;
+    sensor.full_scale_m3_h =
+        section.optional_in_range<double>("full_scale_m3_h", sensor.full_scale_m3_h, Bounds::open_closed(0, 1000));
+    sensor.noise_mv = section.optional_in_range<double>("noise_mv", sensor.noise_mv, Bounds::closed(0, 1000));
+    sensor.offset_ma = section.optional_in_range<double>("offset_ma", sensor.offset_ma, Bounds::closed(-4, 16));
+    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::open_closed(0, 1000));
+    return sensor;
+}
+
+BoomHeightSensorSpec read_boom_height_sensor(const YamlSection& section) {
+    BoomHeightSensorSpec sensor;
+    sensor.range_m = section.optional_in_range<double>("range_m", sensor.range_m, Bounds::open_closed(0, 10));
+    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::open_closed(0, 1000));
+    return sensor;
+}
+
+DepositionSpec read_deposition(const YamlSection& section) {
+    DepositionSpec deposition;
+    deposition.cell_m = section.optional_in_range<double>("cell_m", deposition.cell_m, Bounds::closed(0.005, 1));
+    deposition.footprint_m =
+        section.optional_in_range<double>("footprint_m", deposition.footprint_m, Bounds::closed(0.01, 2));
+    deposition.sprayed_fraction =
+        section.optional_in_range<double>("sprayed_fraction", deposition.sprayed_fraction, Bounds::open(0, 1));
+    deposition.cv_row_m = section.optional_in_range<double>("cv_row_m", deposition.cv_row_m, Bounds::closed(0.01, 5));
+    deposition.cv_window_m =
+        section.optional_in_range<double>("cv_window_m", deposition.cv_window_m, Bounds::closed(0.1, 100));
+    return deposition;
+}
+
+StaticFlowSpec read_static_flow(const YamlSection& section) {
+    StaticFlowSpec static_flow;
+    static_flow.spray_on_at_s =
+        section.optional_in_range<double>("spray_on_at_s", static_flow.spray_on_at_s, Bounds::closed(0, 3600));
+    static_flow.spray_for_s =
+        section.optional_in_range<double>("spray_for_s", static_flow.spray_for_s, Bounds::open_closed(0, 3600));
+    return static_flow;
+}
+
 // The section stays raw for the controller; only `command` is the rig's. It is
 // read through a separate YamlSection (never finish()ed) so the controller's
 // own keys are not reported as unknown here.
@@ -198,6 +310,11 @@ ControllerSpec read_controller(const YamlSection& root) {
         if (controller.command.empty()) {
             section.fail("command", "must name the controller executable, e.g. [ \"rig-controller\" ]");
         }
+    }
+    // The harness judges flow against the target the controller is given.
+    if (section.has("target_flow_l_min")) {
+        controller.target_flow_l_min =
+            section.required_in_range<double>("target_flow_l_min", Bounds::open_closed(0, 250));
     }
     return controller;
 }
@@ -231,7 +348,7 @@ TimeoutsSpec read_timeouts(const YamlSection& section) {
 // Checks between sections; run after finish(), when every value is real.
 void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                         const std::map<std::string, double>& default_limits) {
-    if (!(spec.vehicle.start_m < spec.breakpoint.along_m)) {
+    if (spec.scenario != Scenario::static_flow && !(spec.vehicle.start_m < spec.breakpoint.along_m)) {
         root.section("vehicle").fail("start_m", "must be < breakpoint.along_m (" +
                                                     number_text(spec.breakpoint.along_m) +
                                                     ") so the vehicle approaches the breakpoint, got " +
@@ -240,7 +357,8 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     const YamlSection expect = root.section("expect");
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
         const std::string& metric = spec.expect.fail[index];
-        if (!spec.limits.contains(metric) && !default_limits.contains(metric)) {
+        if (!spec.limits.contains(metric) &&
+            !(default_limits.contains(metric) && default_limit_applies(spec.scenario, metric))) {
             throw ConfigError(expect.item_location("fail", index),
                               "'" + metric + "' has no limit; expected failures must name limited metrics "
                               "(limits in this file or the defaults)");
@@ -256,6 +374,17 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
 }  // namespace
 
 std::string_view to_string(RunMode mode) { return name_of(kRunModes, mode); }
+std::string_view to_string(Scenario scenario) { return name_of(kScenarios, scenario); }
+
+bool default_limit_applies(Scenario scenario, const std::string& metric) {
+    const bool identifies = scenario != Scenario::static_flow;
+    const bool sprays = scenario != Scenario::breakpoint_identification;
+    const bool continues = scenario == Scenario::breakpoint_continuation;
+    if (metric == "breakpoint_error_m") return identifies;
+    if (metric == "flow_adjust_time_s" || metric == "flow_error_pct") return sprays;
+    if (metric == "overlap_m" || metric == "missed_m") return continues;
+    return true;
+}
 std::string_view to_string(GnssTalker talker) { return name_of(kTalkers, talker); }
 std::string_view to_string(GnssFix fix) { return name_of(kFixes, fix); }
 
@@ -287,7 +416,10 @@ std::string metric_name_problem(std::string_view name) {
 }
 
 std::map<std::string, double> effective_limits(const CaseSpec& spec, const std::map<std::string, double>& defaults) {
-    std::map<std::string, double> limits = defaults;
+    std::map<std::string, double> limits;
+    for (const auto& [name, limit] : defaults) {
+        if (default_limit_applies(spec.scenario, name)) limits[name] = limit;
+    }
     for (const auto& [name, limit] : spec.limits) limits[name] = limit;
     return limits;
 }
@@ -306,6 +438,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.description = root.optional<std::string>("description", "");
     spec.seed = root.optional<std::uint64_t>("seed", spec.seed);
     spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
+    spec.scenario = root.optional_enum<Scenario>("scenario", kScenarios, spec.scenario);
     spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);
     const auto utc_start = parse_utc(spec.utc_start_iso);
     if (!utc_start) {
@@ -315,11 +448,18 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.utc_start = *utc_start;
 
     spec.field = read_field(root.required_section("field"));
-    spec.vehicle = read_vehicle(root.required_section("vehicle"));
+    const bool standing = spec.scenario == Scenario::static_flow;
+    spec.vehicle = read_vehicle(standing ? root.section("vehicle") : root.required_section("vehicle"), standing);
     spec.boom = read_boom(root.section("boom"));
     spec.breakpoint = read_breakpoint(root.section("breakpoint"));
     spec.gnss = read_gnss(root.section("gnss"));
     spec.encoder = read_encoder(root.section("encoder"));
+    spec.hydraulics = read_hydraulics(root.section("hydraulics"));
+    spec.flow_meter = read_flow_meter(root.section("flow_meter"));
+    spec.pump_sensor = read_pump_sensor(root.section("pump_sensor"));
+    spec.boom_height_sensor = read_boom_height_sensor(root.section("boom_height_sensor"));
+    spec.deposition = read_deposition(root.section("deposition"));
+    spec.static_flow = read_static_flow(root.section("static_flow"));
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
     spec.expect = read_expect(root.section("expect"));

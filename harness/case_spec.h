@@ -26,12 +26,23 @@
 namespace rig::harness {
 
 enum class RunMode { lockstep, realtime };
+// What the vehicle and the operator do (harness/case_runner.cpp builds the route):
+//   breakpoint_identification  drive to the breakpoint, stop, press the button,
+//                              come back and approach it again (Tables 3, 4, Fig. 13);
+//                              spray switch off.
+//   breakpoint_continuation    the same with the spray switch on: spray the first
+//                              pass up to the breakpoint, continue spraying from it
+//                              (Tables 5, 6, Fig. 14, 15).
+//   static_flow                the sprayer stands; the spray switch is turned on
+//                              and off (Tables 1, 2: the static tests of sec. 2.4).
+enum class Scenario { breakpoint_identification, breakpoint_continuation, static_flow };
 // NMEA talker id of the emulated receiver: GPS, multi-constellation, BeiDou (two spellings).
 enum class GnssTalker { gp, gn, bd, gb };
 enum class GnssFix { rtk_fixed, rtk_float, dgps, autonomous };
 
 // The spelling used in case files ("lockstep", "GP", "rtk_fixed").
 std::string_view to_string(RunMode mode);
+std::string_view to_string(Scenario scenario);
 std::string_view to_string(GnssTalker talker);
 std::string_view to_string(GnssFix fix);
 
@@ -51,6 +62,10 @@ struct VehicleSpec {
     double accel_m_s2 = 0.5;  // (0, 5]
     double start_m = 0.0;     // required: nozzle line along the A-B line at approach start, < breakpoint.along_m
     double overrun_m = 5.0;   // driven past the breakpoint before the case ends, >= 0
+    // The first pass ends with the nozzle line at the breakpoint; it starts this far before it.
+    double first_pass_m = 10.0;          // > 0
+    // Standing still before the first pass (time for the controller's valve reset), >= 0.
+    double wait_before_first_pass_s = 0.0;
 };
 
 // Antenna-to-nozzle geometry of Eq. 6: L4 = L1 + cos(atan(h/L2))*L2 + L3, 1.63 m with these values.
@@ -116,6 +131,59 @@ struct EncoderSpec {
     double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 
+// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
+struct HydraulicsSpec {
+    double pump_flow_l_min = 31.1;           // (0, 200]
+    double pump_pulsation_pct = 2.0;         // [0, 50]
+    double pump_pulsation_hz = 27.0;         // > 0
+    double pipeline_time_constant_s = 0.25;  // (0, 10]
+    double valve_travel_s = 11.0;            // sec. 3.1.2: closed -> open in 11 s
+    double valve_backlash_pct = 0.3;
+    double valve_motor_start_delay_s = 0.02;
+    double valve_initial_opening_pct = 85.0;
+    double interpolation_bulge_pct = 3.0;
+    double calibration_drift_pct = 1.5;
+    std::vector<int> section_nozzles = {8, 6, 8};   // 22 nozzles
+    double boom_width_m = 12.2;
+    double section_valve_open_s = 0.200;     // Table 1 t3
+    double section_valve_close_s = 0.200;
+    double droplet_fall_s = 0.067;           // Table 1 t5
+    double min_nozzle_flow_l_min = 0.64;
+};
+
+struct FlowMeterSpec {
+    double pulses_per_l = 90.0;              // KF11-P10, Eq. 3
+    double k_factor_error_pct = 0.0;
+    double rate_hz = 100.0;
+};
+
+struct PumpSensorSpec {
+    double full_scale_m3_h = 6.0;            // Q_F of Eq. 8
+    double noise_mv = 2.0;
+    double offset_ma = 0.0;
+    double rate_hz = 20.0;
+};
+
+struct BoomHeightSensorSpec {
+    double range_m = 1.0;
+    double rate_hz = 10.0;
+};
+
+// How the ground's deposition is judged (harness/metrics.h).
+struct DepositionSpec {
+    double cell_m = 0.05;            // grid resolution along the track
+    double footprint_m = 0.15;       // a flat fan's band along the track
+    double sprayed_fraction = 0.5;   // a row counts as sprayed above this share of the pass's nominal dose
+    double cv_row_m = 0.3;           // rows for the CV of Eq. 10-12 (the paper's filter papers were 30 cm apart)
+    double cv_window_m = 6.0;        // operational / continuation areas: this far either side of the repeated one
+};
+
+// The static tests: spray switch on at spray_on_at_s for spray_for_s (vehicle standing).
+struct StaticFlowSpec {
+    double spray_on_at_s = 10.0;
+    double spray_for_s = 8.0;
+};
+
 struct ControllerSpec {
     // argv of the controller executable; empty = the reference controller.
     std::vector<std::string> command;
@@ -123,6 +191,9 @@ struct ControllerSpec {
     // controller to validate. It includes `command`, which belongs to the rig:
     // a controller checking its keys must allow it (kControllerRigKeys).
     RawYaml params;
+    // The flow the controller is told to hold (its `target_flow_l_min`, 20 L/min if
+    // absent); the harness judges flow against the same number.
+    double target_flow_l_min = 20.0;
 };
 // Keys of the controller section that the rig reads itself.
 inline constexpr std::array<std::string_view, 1> kControllerRigKeys = {"command"};
@@ -144,6 +215,7 @@ struct CaseSpec {
     std::string description;
     std::uint64_t seed = 1;  // `rig run --seed` overrides
     RunMode mode = RunMode::lockstep;
+    Scenario scenario = Scenario::breakpoint_identification;
     std::string utc_start_iso = "2023-07-15T02:00:00Z";
     // GNSS UTC = utc_start + simulated time.
     std::chrono::sys_time<std::chrono::nanoseconds> utc_start;
@@ -153,6 +225,12 @@ struct CaseSpec {
     BreakpointSpec breakpoint;
     GnssSpec gnss;
     EncoderSpec encoder;
+    HydraulicsSpec hydraulics;
+    FlowMeterSpec flow_meter;
+    PumpSensorSpec pump_sensor;
+    BoomHeightSensorSpec boom_height_sensor;
+    DepositionSpec deposition;
+    StaticFlowSpec static_flow;
     ControllerSpec controller;
     // Limits as written in the file (metric name -> max allowed value); the
     // harness judges against effective_limits(), i.e. these over the defaults.
@@ -161,13 +239,18 @@ struct CaseSpec {
     TimeoutsSpec timeouts;
 };
 
-// Limits every case gets unless its file overrides them. Only metrics the
-// harness actually measures belong here (a limited metric that is not measured
-// fails the case): add flow_adjust_time_s 1.7, flow_error_pct 3, overlap_m 3.3,
-// missed_m 0 (DESIGN.md "What the harness measures") as they are implemented.
+// Limits every case gets unless its file overrides them (DESIGN.md "What the
+// harness measures"), each only where its scenario measures it
+// (default_limit_applies): a limited metric that is not measured fails the case.
 inline const std::map<std::string, double> kDefaultLimits = {
     {"breakpoint_error_m", 0.16},  // Table 3: fusion max 15.85 cm
+    {"flow_adjust_time_s", 1.7},   // Table 2: longest 1.716 s
+    {"flow_error_pct", 3.0},       // Table 5
+    {"overlap_m", 3.3},            // Table 6: at most 3.3 m repeated
+    {"missed_m", 0.0},             // Table 6: no missed spraying
 };
+// Whether the harness measures `metric` in cases of this scenario.
+bool default_limit_applies(Scenario scenario, const std::string& metric);
 
 // Unit suffixes a metric (limit) name may end with, as `_<suffix>`.
 // Names are snake_case: [a-z][a-z0-9]*(_[a-z0-9]+)*, with at least one word

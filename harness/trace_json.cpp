@@ -7,6 +7,19 @@ const char* to_string(msg::BreakpointEventKind kind) {
         case msg::BREAKPOINT_STORED: return "stored";
         case msg::BREAKPOINT_REACHED: return "reached";
         case msg::BREAKPOINT_CLEARED: return "cleared";
+        case msg::SPRAY_RESUMED: return "spray_resumed";
+    }
+    return "unknown";
+}
+
+const char* to_string(msg::SprayPhase phase) {
+    switch (phase) {
+        case msg::SPRAY_VALVE_RESET: return "valve_reset";
+        case msg::SPRAY_IDLE: return "idle";
+        case msg::SPRAY_PRE_ADJUST: return "pre_adjust";
+        case msg::SPRAY_REGULATING: return "regulating";
+        case msg::SPRAY_HALTED: return "halted";
+        case msg::SPRAY_APPROACH: return "approach";
     }
     return "unknown";
 }
@@ -19,7 +32,33 @@ nlohmann::json to_json(const msg::NmeaSentence& sample) {
 
 nlohmann::json to_json(const msg::EncoderCount& sample) { return {{"count_pulses", sample.count_pulses()}}; }
 
-nlohmann::json to_json(const msg::ButtonLevel& sample) { return {{"pressed", sample.pressed()}}; }
+nlohmann::json to_json(const msg::FlowMeterCount& sample) {
+    return {{"count_pulses", sample.count_pulses()}, {"last_edge_capture_us", sample.last_edge_capture_us()}};
+}
+
+nlohmann::json to_json(const msg::AnalogInput& sample) { return {{"voltage_v", sample.voltage_v()}}; }
+
+nlohmann::json to_json(const msg::SwitchLevel& sample) { return {{"closed", sample.closed()}}; }
+
+nlohmann::json to_json(const msg::BallValveRelays& sample) {
+    return {{"forward", sample.forward()}, {"reverse", sample.reverse()}};
+}
+
+nlohmann::json to_json(const msg::SectionValves& sample) { return {{"open_mask", sample.open_mask()}}; }
+
+nlohmann::json to_json(const msg::UnloadingValve& sample) { return {{"open", sample.open()}}; }
+
+nlohmann::json to_json(const msg::HydraulicsTruth& sample) {
+    return {{"time_ns", sample.time_ns()},
+            {"pump_flow_l_min", sample.pump_flow_l_min()},
+            {"valve_opening_pct", sample.valve_opening_pct()},
+            {"main_flow_l_min", sample.main_flow_l_min()},
+            {"main_volume_l", sample.main_volume_l()},
+            {"sections_commanded_mask", sample.sections_commanded_mask()},
+            {"sections_spraying_mask", sample.sections_spraying_mask()},
+            {"unloading_open", sample.unloading_open()},
+            {"nozzles_spraying", sample.nozzles_spraying()}};
+}
 
 nlohmann::json to_json(const msg::ControllerStatus& sample) {
     return {{"time_ns", sample.time_ns()},
@@ -30,7 +69,14 @@ nlohmann::json to_json(const msg::ControllerStatus& sample) {
             {"speed_km_h", sample.speed_km_h()},
             {"l4_m", sample.l4_m()},
             {"gnss_fix_quality", sample.gnss_fix_quality()},
-            {"nmea_rejected_count", sample.nmea_rejected_count()}};
+            {"nmea_rejected_count", sample.nmea_rejected_count()},
+            {"spray_phase", to_string(sample.spray_phase())},
+            {"target_flow_l_min", sample.target_flow_l_min()},
+            {"measured_flow_l_min", sample.measured_flow_l_min()},
+            {"pump_flow_l_min", sample.pump_flow_l_min()},
+            {"valve_opening_estimate_pct", sample.valve_opening_estimate_pct()},
+            {"valve_opening_command_pct", sample.valve_opening_command_pct()},
+            {"boom_height_m", sample.boom_height_m()}};
 }
 
 nlohmann::json to_json(const msg::BreakpointEvent& sample) {
@@ -53,7 +99,8 @@ nlohmann::json to_json(const msg::VehicleTruth& sample) {
             {"nozzle_line_along_m", sample.nozzle_line_along_m()},
             {"l4_m", sample.l4_m()},
             {"boom_height_m", sample.boom_height_m()},
-            {"wheel_travel_m", sample.wheel_travel_m()}};
+            {"wheel_travel_m", sample.wheel_travel_m()},
+            {"pass_index", sample.pass_index()}};
 }
 
 }  // namespace rig::harness

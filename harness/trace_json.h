@@ -9,10 +9,17 @@ namespace rig::harness {
 
 nlohmann::json to_json(const msg::NmeaSentence& sample);
 nlohmann::json to_json(const msg::EncoderCount& sample);
-nlohmann::json to_json(const msg::ButtonLevel& sample);
+nlohmann::json to_json(const msg::FlowMeterCount& sample);
+nlohmann::json to_json(const msg::AnalogInput& sample);
+nlohmann::json to_json(const msg::SwitchLevel& sample);
+nlohmann::json to_json(const msg::BallValveRelays& sample);
+nlohmann::json to_json(const msg::SectionValves& sample);
+nlohmann::json to_json(const msg::UnloadingValve& sample);
+nlohmann::json to_json(const msg::HydraulicsTruth& sample);
 nlohmann::json to_json(const msg::ControllerStatus& sample);
 nlohmann::json to_json(const msg::BreakpointEvent& sample);
 nlohmann::json to_json(const msg::VehicleTruth& sample);
 const char* to_string(msg::BreakpointEventKind kind);
+const char* to_string(msg::SprayPhase phase);
 
 }  // namespace rig::harness

@@ -41,8 +41,27 @@ CREATE VIEW breakpoint_events AS SELECT t_ns / 1e9 AS t_s, json_extract(json, '$
 CREATE VIEW controller_status AS SELECT t_ns / 1e9 AS t_s,
   json_extract(json, '$.nozzle_to_breakpoint_m') AS nozzle_to_breakpoint_m,
   json_extract(json, '$.odometer_active') AS odometer_active,
-  json_extract(json, '$.speed_km_h') AS speed_km_h
+  json_extract(json, '$.speed_km_h') AS speed_km_h,
+  json_extract(json, '$.spray_phase') AS spray_phase,
+  json_extract(json, '$.measured_flow_l_min') AS measured_flow_l_min,
+  json_extract(json, '$.valve_opening_estimate_pct') AS valve_opening_estimate_pct,
+  json_extract(json, '$.valve_opening_command_pct') AS valve_opening_command_pct
   FROM samples WHERE topic = 'controller/status';
+CREATE VIEW hydraulics AS SELECT t_ns / 1e9 AS t_s,
+  json_extract(json, '$.main_flow_l_min') AS main_flow_l_min,
+  json_extract(json, '$.pump_flow_l_min') AS pump_flow_l_min,
+  json_extract(json, '$.valve_opening_pct') AS valve_opening_pct,
+  json_extract(json, '$.sections_spraying_mask') AS sections_spraying_mask,
+  json_extract(json, '$.nozzles_spraying') AS nozzles_spraying
+  FROM samples WHERE topic = 'truth/hydraulics';
+CREATE VIEW actuators AS SELECT t_ns / 1e9 AS t_s, topic, json
+  FROM samples WHERE topic LIKE 'actuator/%';
+-- Spray on the ground (plant truth), written at the end of the run: dose per
+-- grid cell (pass 0 = first pass, 1 = continuation), nozzle columns left to right.
+CREATE TABLE deposition (pass INTEGER NOT NULL, along_m REAL NOT NULL, nozzle INTEGER NOT NULL,
+  dose_ul_cm2 REAL NOT NULL);
+CREATE VIEW deposition_rows AS SELECT pass, along_m, avg(dose_ul_cm2) AS mean_dose_ul_cm2
+  FROM deposition GROUP BY pass, along_m;
 BEGIN;
 )sql";
 
@@ -64,7 +83,15 @@ TraceRecorder::TraceRecorder(DdsContext& dds, const std::filesystem::path& file)
     add_channel<msg::VehicleTruth>(dds, topics::kVehicleTruth);
     add_channel<msg::NmeaSentence>(dds, topics::kGnssNmea);
     add_channel<msg::EncoderCount>(dds, topics::kWheelEncoder);
-    add_channel<msg::ButtonLevel>(dds, topics::kBreakpointButton);
+    add_channel<msg::HydraulicsTruth>(dds, topics::kHydraulicsTruth);
+    add_channel<msg::FlowMeterCount>(dds, topics::kMainFlowMeter);
+    add_channel<msg::AnalogInput>(dds, topics::kPumpFlowSensor);
+    add_channel<msg::AnalogInput>(dds, topics::kBoomHeightSensor);
+    add_channel<msg::SwitchLevel>(dds, topics::kBreakpointButton);
+    add_channel<msg::SwitchLevel>(dds, topics::kSpraySwitch);
+    add_channel<msg::BallValveRelays>(dds, topics::kBallValveRelays);
+    add_channel<msg::SectionValves>(dds, topics::kSectionValves);
+    add_channel<msg::UnloadingValve>(dds, topics::kUnloadingValve);
     add_channel<msg::ControllerStatus>(dds, topics::kControllerStatus);
     add_channel<msg::BreakpointEvent>(dds, topics::kBreakpointEvent);
 
@@ -113,6 +140,37 @@ void TraceRecorder::drain(TimeNs t, int round) {
     for (const Channel& channel : channels_) {
         for (const nlohmann::json& json : channel.take()) append(t, round, channel.topic, json);
     }
+}
+
+void TraceRecorder::record_deposition(const emulators::DepositionGrid& grid) {
+    sqlite3_stmt* statement = nullptr;
+    if (sqlite3_prepare_v2(db_, "INSERT INTO deposition VALUES (?, ?, ?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
+        throw std::runtime_error(std::string("trace: ") + sqlite3_errmsg(db_));
+    }
+    // Non-empty cells only; each one also goes into the digest, so a changed
+    // deposition changes trace_sha256 like a changed sample does.
+    for (int pass = 0; pass < grid.pass_count(); ++pass) {
+        for (std::size_t row = 0; row < grid.row_count(); ++row) {
+            for (int nozzle = 0; nozzle < grid.params().nozzle_count; ++nozzle) {
+                const double dose = grid.dose_ul_cm2(pass, row, nozzle);
+                if (dose <= 0.0) continue;
+                const std::string canonical = "deposition " + std::to_string(pass) + " " + std::to_string(row) + " " +
+                                              std::to_string(nozzle) + " " + nlohmann::json(dose).dump() + "\n";
+                EVP_DigestUpdate(digest_, canonical.data(), canonical.size());
+                sqlite3_bind_int(statement, 1, pass);
+                sqlite3_bind_double(statement, 2, grid.row_centre_m(row));
+                sqlite3_bind_int(statement, 3, nozzle);
+                sqlite3_bind_double(statement, 4, dose);
+                if (sqlite3_step(statement) != SQLITE_DONE) {
+                    const std::string error = sqlite3_errmsg(db_);
+                    sqlite3_finalize(statement);
+                    throw std::runtime_error("trace: " + error);
+                }
+                sqlite3_reset(statement);
+            }
+        }
+    }
+    sqlite3_finalize(statement);
 }
 
 std::string TraceRecorder::finish() {

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "emulators/deposition_grid.h"
 #include "rig/clock.h"
 #include "rig/dds_context.h"
 
@@ -34,6 +35,8 @@ public:
     void set_meta(const std::string& key, const std::string& value);
     // Takes every sample that arrived and records it at (t, round).
     void drain(TimeNs t, int round);
+    // Writes the plant's deposition grid (table `deposition`); part of the digest.
+    void record_deposition(const emulators::DepositionGrid& grid);
     // Commits and closes the file; returns the hex SHA-256 of the trace.
     std::string finish();
 

@@ -1,6 +1,7 @@
 #pragma once
 // Maps each generated message type to its fastddsgen PubSubType, so rig::Writer<T>
 // and rig::Reader<T> can register types without the caller naming them twice.
+#include "actuatorPubSubTypes.h"
 #include "clockPubSubTypes.h"
 #include "controllerPubSubTypes.h"
 #include "devicePubSubTypes.h"
@@ -21,10 +22,16 @@ RIG_DECLARE_MSG(ClockTick)
 RIG_DECLARE_MSG(ClockAck)
 RIG_DECLARE_MSG(NmeaSentence)
 RIG_DECLARE_MSG(EncoderCount)
-RIG_DECLARE_MSG(ButtonLevel)
+RIG_DECLARE_MSG(FlowMeterCount)
+RIG_DECLARE_MSG(AnalogInput)
+RIG_DECLARE_MSG(SwitchLevel)
+RIG_DECLARE_MSG(BallValveRelays)
+RIG_DECLARE_MSG(SectionValves)
+RIG_DECLARE_MSG(UnloadingValve)
 RIG_DECLARE_MSG(BreakpointEvent)
 RIG_DECLARE_MSG(ControllerStatus)
 RIG_DECLARE_MSG(VehicleTruth)
+RIG_DECLARE_MSG(HydraulicsTruth)
 
 #undef RIG_DECLARE_MSG
 

@@ -13,9 +13,18 @@ inline constexpr const char* kDdsCheckPing = "rig/dds_check/ping";  // msg::Nmea
 inline constexpr const char* kDdsCheckPong = "rig/dds_check/pong";  // msg::NmeaSentence
 
 // Device topics (emulators -> controller)
-inline constexpr const char* kGnssNmea = "device/gnss/nmea";         // msg::NmeaSentence
-inline constexpr const char* kWheelEncoder = "device/wheel_encoder/count";  // msg::EncoderCount
-inline constexpr const char* kBreakpointButton = "device/breakpoint_button/level";  // msg::ButtonLevel
+inline constexpr const char* kGnssNmea = "device/gnss/nmea";                        // msg::NmeaSentence
+inline constexpr const char* kWheelEncoder = "device/wheel_encoder/count";          // msg::EncoderCount
+inline constexpr const char* kMainFlowMeter = "device/main_flow_meter/count";       // msg::FlowMeterCount
+inline constexpr const char* kPumpFlowSensor = "device/pump_flow_sensor/voltage";   // msg::AnalogInput
+inline constexpr const char* kBoomHeightSensor = "device/boom_height_sensor/voltage";  // msg::AnalogInput
+inline constexpr const char* kBreakpointButton = "device/breakpoint_button/level";   // msg::SwitchLevel
+inline constexpr const char* kSpraySwitch = "device/spray_switch/level";             // msg::SwitchLevel
+
+// Actuator topics (controller -> plant)
+inline constexpr const char* kBallValveRelays = "actuator/ball_valve/relays";      // msg::BallValveRelays
+inline constexpr const char* kSectionValves = "actuator/section_valves/open";      // msg::SectionValves
+inline constexpr const char* kUnloadingValve = "actuator/unloading_valve/open";    // msg::UnloadingValve
 
 // Controller outputs
 inline constexpr const char* kControllerStatus = "controller/status";          // msg::ControllerStatus
@@ -23,5 +32,6 @@ inline constexpr const char* kBreakpointEvent = "controller/breakpoint_event"; /
 
 // Truth (plant -> harness, emulators)
 inline constexpr const char* kVehicleTruth = "truth/vehicle";        // msg::VehicleTruth
+inline constexpr const char* kHydraulicsTruth = "truth/hydraulics";  // msg::HydraulicsTruth
 
 }  // namespace rig::topics

@@ -14,6 +14,11 @@ inline constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
 constexpr TimeNs seconds_to_ns(double s) { return static_cast<TimeNs>(s * 1e9 + (s >= 0 ? 0.5 : -0.5)); }
 constexpr double ns_to_seconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
 
+// The first multiple of period_ns strictly after now_ns: the next wake of a node
+// that runs on a fixed grid (every sample of a 100 Hz device lands on k x 10 ms,
+// whenever the node happened to be woken).
+constexpr TimeNs next_period_boundary(TimeNs now_ns, TimeNs period_ns) { return (now_ns / period_ns + 1) * period_ns; }
+
 class Clock {
 public:
     virtual ~Clock() = default;

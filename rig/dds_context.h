@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -43,6 +44,8 @@ public:
     int matched_readers() const { return listener_.matched.load(); }
     // Blocks until every reader matched now has acknowledged every sample written.
     bool wait_delivered(std::chrono::milliseconds timeout);
+    // Written to since the last successful wait_delivered() (only those need waiting for).
+    bool has_undelivered() const { return undelivered_.load(); }
 
 protected:
     WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output);
@@ -60,6 +63,7 @@ private:
     MatchListener listener_;
     dds::DataWriter* writer_ = nullptr;
     bool counts_as_output_;
+    std::atomic<bool> undelivered_{false};
 };
 
 // A typed writer on one topic. Each publish() is counted by the context, which is
@@ -144,6 +148,9 @@ public:
     // Waits until every writer's samples are acknowledged by all matched readers.
     // Returns the topics that did not make it in time (empty = all delivered).
     std::vector<std::string> wait_all_delivered(std::chrono::milliseconds timeout);
+    // Only the writers for which `needs_wait(topic)` is true.
+    std::vector<std::string> wait_delivered_where(std::chrono::milliseconds timeout,
+                                                  const std::function<bool(const std::string&)>& needs_wait);
 
     // Registry used by wait_all_delivered and endpoint-matching checks.
     void register_writer(WriterBase* writer);

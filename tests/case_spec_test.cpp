@@ -216,7 +216,38 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     EXPECT_TRUE(spec.expect.fail.empty());
     EXPECT_DOUBLE_EQ(spec.timeouts.node_ack_s, 10.0);
     EXPECT_DOUBLE_EQ(spec.timeouts.case_wall_s, 600.0);
-    EXPECT_EQ(effective_limits(spec), kDefaultLimits);
+    // An identification case measures only the breakpoint error of the defaults.
+    EXPECT_EQ(spec.scenario, Scenario::breakpoint_identification);
+    EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"breakpoint_error_m", 0.16}}));
+}
+
+TEST(CaseSpec, DefaultLimitsFollowWhatTheScenarioMeasures) {
+    const CaseSpec continuation =
+        parse_case(std::string(kMinimalCase) + "scenario: breakpoint_continuation\n", "continuation.yaml");
+    EXPECT_EQ(effective_limits(continuation), kDefaultLimits);
+    const CaseSpec static_test = parse_case(std::string(kMinimalCase) + "scenario: static_flow\n", "static.yaml");
+    EXPECT_EQ(effective_limits(static_test),
+              (std::map<std::string, double>{{"flow_adjust_time_s", 1.7}, {"flow_error_pct", 3.0}}));
+    // A default the scenario does not measure cannot be expected to fail...
+    EXPECT_THROW(parse_case(std::string(kMinimalCase) + "scenario: static_flow\nexpect: { fail: [ missed_m ] }\n",
+                            "static.yaml"),
+                 ConfigError);
+    // ...unless the file gives it a limit of its own.
+    EXPECT_NO_THROW(parse_case(std::string(kMinimalCase) +
+                                   "scenario: static_flow\nlimits: { missed_m: 0 }\nexpect: { fail: [ missed_m ] }\n",
+                               "static.yaml"));
+}
+
+TEST(CaseSpec, StaticTestNeedsNoVehicle) {
+    const CaseSpec spec = parse_case(R"(name: static
+scenario: static_flow
+field: { origin: { lat_deg: 40.18, lon_deg: 116.44 }, heading_deg: 90 }
+static_flow: { spray_on_at_s: 9, spray_for_s: 5 }
+controller: { target_flow_l_min: 24 }
+)",
+                                     "static.yaml");
+    EXPECT_DOUBLE_EQ(spec.static_flow.spray_on_at_s, 9.0);
+    EXPECT_DOUBLE_EQ(spec.controller.target_flow_l_min, 24.0);
 }
 
 TEST(CaseSpec, EmptySectionsTakeDefaultsAndDefaultLimitsCanBeExpectedToFail) {
@@ -232,11 +263,11 @@ expect: { fail: [ breakpoint_error_m ] }
 
 TEST(CaseSpec, HarnessCanExtendTheDefaultLimits) {
     std::map<std::string, double> defaults = kDefaultLimits;
-    defaults["overlap_m"] = 3.3;
-    const std::string text = std::string(kMinimalCase) + "expect: { fail: [ overlap_m ] }\n";
+    defaults["spray_drift_m"] = 0.5;
+    const std::string text = std::string(kMinimalCase) + "expect: { fail: [ spray_drift_m ] }\n";
     EXPECT_THROW(parse_case(text, "case.yaml"), ConfigError);
     const CaseSpec spec = parse_case(text, "case.yaml", defaults);
-    EXPECT_EQ(effective_limits(spec, defaults).at("overlap_m"), 3.3);
+    EXPECT_EQ(effective_limits(spec, defaults).at("spray_drift_m"), 0.5);
 }
 
 // ------------------------------------------------------------------ broken files

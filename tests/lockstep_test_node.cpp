@@ -31,7 +31,7 @@ public:
             pong.sentence(ping.sentence().to_string() + " #" + std::to_string(++count_) + " @" + std::to_string(now_ns));
             pong_->publish(pong);
         }
-        return (now_ns / period_ns_ + 1) * period_ns_;
+        return rig::next_period_boundary(now_ns, period_ns_);
     }
 
 private:

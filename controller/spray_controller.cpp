@@ -1,0 +1,388 @@
+#include "controller/spray_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "controller/breakpoint_equations.h"
+#include "controller/flow_equations.h"
+#include "controller/nmea_parser.h"
+
+namespace rig::controller {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+}  // namespace
+
+SprayController::SprayController(ControllerConfig config, const std::filesystem::path& state_dir)
+    : config_(std::move(config)),
+      store_(state_dir / config_.breakpoint_store_file),
+      locator_(config_),
+      calibration_(config_.calibration),
+      valve_(config_.valve),
+      pid_(config_.pid, config_.pid_integral_limit_l_min),
+      flow_meter_(config_.flow_meter_pulses_per_l, config_.flow_window_s),
+      linkage_rise_m_(config_.linkage_rise_m) {
+    store_.load();  // a corrupt store is an error here, before time starts
+}
+
+void SprayController::start(TimeNs now_ns) {
+    started_ = true;
+    select_target();
+    // A breakpoint left in the store by an earlier run still waits for its continuation.
+    halted_ = !store_.list().empty();
+    actuators_.unloading_valve_open = true;
+    actuators_.section_valves_open = 0;
+    valve_.start_reset(now_ns);
+    enter(msg::SPRAY_VALVE_RESET, now_ns);
+    next_pid_ns_ = now_ns;
+}
+
+// ------------------------------------------------------------------ inputs
+
+void SprayController::on_nmea_sentence(const std::string& line, TimeNs now_ns) {
+    const nmea::ParseResult result = nmea::parse_sentence(line);
+    if (!result.ok()) {
+        ++rejected_sentences_;
+        return;
+    }
+    const nmea::Sentence& sentence = *result.sentence;
+    if (const auto* gga = std::get_if<nmea::GgaData>(&sentence.data)) {
+        last_quality_ = gga->fix_quality.value_or(0);
+        if (last_quality_ > 0 && gga->position) {
+            last_fix_ = FixInput{gga->position->lat_deg, gga->position->lon_deg, last_course_deg_, last_quality_};
+        } else {
+            last_fix_.reset();
+        }
+        return;
+    }
+    if (const auto* rmc = std::get_if<nmea::RmcData>(&sentence.data)) {
+        if (rmc->course_true_deg) last_course_deg_ = *rmc->course_true_deg;
+        // The G970II sends GGA then RMC for one epoch: the epoch is complete here.
+        if (last_fix_ && rmc->status == nmea::DataStatus::valid) handle_fix_complete(now_ns);
+    }
+}
+
+void SprayController::handle_fix_complete(TimeNs now_ns) {
+    last_fix_->course_deg = last_course_deg_;
+    on_locator_event(locator_.on_fix(*last_fix_, latest_count_, speed_m_s()), now_ns);
+}
+
+void SprayController::on_encoder_count(std::uint32_t count_pulses, TimeNs now_ns) {
+    latest_count_ = count_pulses;
+    encoder_window_.emplace_back(now_ns, count_pulses);
+    const TimeNs window_ns = seconds_to_ns(config_.speed_window_s);
+    while (encoder_window_.size() > 2 && encoder_window_.front().first < now_ns - window_ns) {
+        encoder_window_.pop_front();
+    }
+    on_locator_event(locator_.on_encoder(count_pulses), now_ns);
+}
+
+void SprayController::on_flow_meter_count(std::uint32_t count_pulses,
+                                          std::optional<std::uint32_t> last_edge_capture_us, TimeNs now_ns) {
+    flow_meter_.add_count(count_pulses, last_edge_capture_us, now_ns);
+}
+
+void SprayController::on_pump_sensor_voltage(double voltage_v, TimeNs now_ns) {
+    const double sample_l_min =
+        pump_flow_l_min_from_voltage(voltage_v, config_.pump_sensor_span_v, config_.pump_sensor_full_scale_m3_h);
+    if (!std::isfinite(sample_l_min)) return;
+    if (!pump_flow_l_min_ || config_.pump_flow_smoothing_s <= 0.0) {
+        pump_flow_l_min_ = sample_l_min;
+    } else {
+        // First-order smoothing: the plunger pump pulsates, the pre-adjustment wants the mean.
+        const double dt_s = ns_to_seconds(now_ns - last_pump_sample_ns_);
+        const double weight = 1.0 - std::exp(-std::max(dt_s, 0.0) / config_.pump_flow_smoothing_s);
+        *pump_flow_l_min_ += weight * (sample_l_min - *pump_flow_l_min_);
+    }
+    last_pump_sample_ns_ = now_ns;
+}
+
+void SprayController::on_boom_height_voltage(double voltage_v, TimeNs /*now_ns*/) {
+    const double rise_m = linkage_rise_m_from_voltage(voltage_v, config_.boom_height_span_v, config_.boom_height_range_m);
+    if (!std::isfinite(rise_m) || rise_m == linkage_rise_m_) return;
+    linkage_rise_m_ = rise_m;
+    locator_.set_linkage_rise_m(rise_m);
+}
+
+void SprayController::on_breakpoint_button(bool closed, TimeNs now_ns) {
+    if (closed && !button_closed_) store_breakpoint_here(now_ns);
+    button_closed_ = closed;
+}
+
+void SprayController::on_spray_switch(bool closed, TimeNs /*now_ns*/) { spray_switch_on_ = closed; }
+
+// ------------------------------------------------------------------ breakpoints
+
+void SprayController::on_locator_event(LocatorEvent event, TimeNs now_ns) {
+    // The locator keeps saying "reached" while the nozzle line is past the target;
+    // it is one event per breakpoint.
+    if (event != LocatorEvent::reached || !locator_.target() || reached_) return;
+    reached_ = true;
+    ++reached_count_;
+    publish_event(msg::BREAKPOINT_REACHED, *locator_.target(), now_ns);
+    // Identification only (not spraying its continuation): done with it. A
+    // continuation clears it once the flow is on target (update()).
+    if (!continuing_ || continuation_on_target_) clear_breakpoint(now_ns);
+}
+
+void SprayController::store_breakpoint_here(TimeNs now_ns) {
+    if (!last_fix_ || !last_course_deg_) {
+        notices_.push_back("breakpoint button pressed without a GNSS fix and course; ignored");
+        return;
+    }
+    // The breakpoint is where the spray stopped on the ground: the nozzle line,
+    // L4 (Eq. 6) behind the antenna along the course.
+    const auto [lat_deg, lon_deg] =
+        offset_position_deg(last_fix_->lat_deg, last_fix_->lon_deg, *last_course_deg_ + 180.0, locator_.l4_m());
+    const StoredBreakpoint stored = store_.add(lat_deg, lon_deg, *last_course_deg_);
+    store_.save();
+    ++stored_count_;
+    publish_event(msg::BREAKPOINT_STORED, stored, now_ns);
+    select_target();
+    halted_ = true;
+    if (started_) {
+        close_sections(now_ns);
+        if (phase_ != msg::SPRAY_VALVE_RESET) enter(msg::SPRAY_HALTED, now_ns);
+    }
+}
+
+void SprayController::clear_breakpoint(TimeNs now_ns) {
+    if (!locator_.target()) return;
+    const StoredBreakpoint done = *locator_.target();
+    store_.remove(done.id);
+    store_.save();
+    publish_event(msg::BREAKPOINT_CLEARED, done, now_ns);
+    reached_ = false;
+    continuing_ = false;
+    continuation_on_target_ = false;
+    halted_ = !store_.list().empty();
+    select_target();
+    if (phase_ == msg::SPRAY_HALTED || phase_ == msg::SPRAY_APPROACH) {
+        enter(halted_ ? msg::SPRAY_HALTED : msg::SPRAY_IDLE, now_ns);
+    }
+}
+
+void SprayController::select_target() {
+    // One breakpoint per row: the oldest stored one.
+    const auto& all = store_.list();
+    if (all.empty()) {
+        if (locator_.target()) locator_.set_target(std::nullopt);
+        return;
+    }
+    if (!locator_.target() || locator_.target()->id != all.front().id) {
+        locator_.set_target(all.front());
+        reached_ = false;
+    }
+}
+
+void SprayController::publish_event(msg::BreakpointEventKind kind, const StoredBreakpoint& breakpoint,
+                                    TimeNs now_ns) {
+    msg::BreakpointEvent event;
+    event.time_ns(now_ns);
+    event.breakpoint_id(breakpoint.id);
+    event.kind(kind);
+    event.lat_deg(breakpoint.lat_deg);
+    event.lon_deg(breakpoint.lon_deg);
+    events_.push_back(event);
+}
+
+// ------------------------------------------------------------------ spray sequence
+
+double SprayController::speed_m_s() const {
+    if (encoder_window_.size() < 2) return 0.0;
+    const auto& [t0, c0] = encoder_window_.front();
+    const auto& [t1, c1] = encoder_window_.back();
+    if (t1 <= t0) return 0.0;
+    // Eq. 5 gives km/h; the controller works in m/s internally.
+    return speed_km_h_from_pulses(config_.wheel_diameter_m, c1 - c0, config_.pulses_per_rev, ns_to_seconds(t1 - t0)) /
+           3.6;
+}
+
+bool SprayController::moving_fast_enough() const {
+    return config_.min_spray_speed_km_h <= 0.0 || speed_m_s() * 3.6 >= config_.min_spray_speed_km_h;
+}
+
+std::uint16_t SprayController::all_sections_mask() const {
+    return static_cast<std::uint16_t>((1u << config_.section_count) - 1u);
+}
+
+void SprayController::enter(msg::SprayPhase phase, TimeNs /*now_ns*/) { phase_ = phase; }
+
+void SprayController::open_sections(TimeNs now_ns) {
+    actuators_.unloading_valve_open = false;
+    actuators_.section_valves_open = static_cast<std::uint8_t>(all_sections_mask());
+    sections_opened_ns_ = now_ns;
+    flow_meter_.reset();
+    flow_established_ = false;
+    previous_measurement_l_min_.reset();
+    on_target_since_ns_.reset();
+}
+
+void SprayController::close_sections(TimeNs /*now_ns*/) {
+    actuators_.section_valves_open = 0;
+    actuators_.unloading_valve_open = true;
+    flow_established_ = false;
+}
+
+void SprayController::start_pre_adjust(TimeNs now_ns) {
+    if (!pump_flow_l_min_) return;  // no pump flow reading yet: wait
+    valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
+    valve_.move_to(valve_command_pct_, now_ns);
+    pid_.reset();
+    enter(msg::SPRAY_PRE_ADJUST, now_ns);
+}
+
+bool SprayController::continuation_open_point_reached() const {
+    const std::optional<double> to_go_m = locator_.nozzle_to_breakpoint_m();
+    if (!to_go_m) return false;
+    // Eq. 7: s = s_b + L4 - v (t2 + t3); with the odometer's s, the nozzle line's
+    // distance still to go (s_b + L4 - s) must have come down to v (t2 + t3).
+    const double lead_m = config_.hysteresis_compensation
+                              ? speed_m_s() * (config_.assumed_flow_adjust_s + config_.assumed_spray_delay_s)
+                              : 0.0;
+    return *to_go_m <= lead_m;
+}
+
+void SprayController::regulate(TimeNs now_ns) {
+    const std::optional<double> measured = flow_meter_.flow_l_min();
+    // The flow counts as established once a whole measurement window lies after the
+    // first pulse and two successive measurements agree: until then the pipeline is
+    // still filling, and a PID acting on the rising reading would wind up.
+    if (!flow_established_ && measured && flow_meter_.first_pulse_ns() &&
+        now_ns - *flow_meter_.first_pulse_ns() >= seconds_to_ns(config_.flow_window_s) && previous_measurement_l_min_ &&
+        std::abs(*measured - *previous_measurement_l_min_) <=
+            config_.flow_established_change_pct / 100.0 * config_.target_flow_l_min) {
+        flow_established_ = true;
+    }
+    previous_measurement_l_min_ = measured;
+    if (!flow_established_ || !measured || !pump_flow_l_min_) return;
+
+    const double error_l_min = config_.target_flow_l_min - *measured;
+    const double correction_l_min = pid_.update(error_l_min);
+    valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min + correction_l_min, *pump_flow_l_min_);
+    valve_.move_to(valve_command_pct_, now_ns);
+
+    if (std::abs(error_l_min) <= config_.on_target_band_pct / 100.0 * config_.target_flow_l_min) {
+        if (!on_target_since_ns_) on_target_since_ns_ = now_ns;
+    } else {
+        on_target_since_ns_.reset();
+    }
+    if (continuing_ && !continuation_on_target_ && on_target_since_ns_ &&
+        now_ns - *on_target_since_ns_ >= seconds_to_ns(config_.on_target_hold_s)) {
+        continuation_on_target_ = true;
+        // "Once the target flow rate is reached, normal operation resumes, and the
+        // current breakpoint information is cleared" (sec. 2.2.1) - once reached, too.
+        if (reached_) clear_breakpoint(now_ns);
+    }
+}
+
+TimeNs SprayController::update(TimeNs now_ns) {
+    valve_.update(now_ns);
+    const bool pid_due = now_ns >= next_pid_ns_;
+    if (pid_due) next_pid_ns_ = next_period_boundary(now_ns, seconds_to_ns(config_.pid_period_s));
+
+    switch (phase_) {
+        case msg::SPRAY_VALVE_RESET:
+            if (!valve_.resetting()) enter(halted_ ? msg::SPRAY_HALTED : msg::SPRAY_IDLE, now_ns);
+            break;
+        case msg::SPRAY_IDLE:
+            if (spray_switch_on_ && !halted_) start_pre_adjust(now_ns);
+            break;
+        case msg::SPRAY_PRE_ADJUST:
+            if (!spray_switch_on_) {
+                enter(msg::SPRAY_IDLE, now_ns);
+            } else if (valve_.idle() && moving_fast_enough()) {
+                open_sections(now_ns);
+                enter(msg::SPRAY_REGULATING, now_ns);
+            }
+            break;
+        case msg::SPRAY_REGULATING:
+            if (!spray_switch_on_ || !moving_fast_enough()) {
+                // Zero-speed shutoff (or switch off): the valve stays where the PID left it.
+                close_sections(now_ns);
+                enter(spray_switch_on_ ? msg::SPRAY_PRE_ADJUST : msg::SPRAY_IDLE, now_ns);
+            } else if (pid_due) {
+                regulate(now_ns);
+            }
+            break;
+        case msg::SPRAY_HALTED:
+            if (spray_switch_on_ && locator_.target() && locator_.armed()) {
+                // "When the nearest breakpoint is detected, the proportional control
+                // valve is automatically adjusted to the initial position" (sec. 2.2.1).
+                valve_.start_reset(now_ns);
+                enter(msg::SPRAY_APPROACH, now_ns);
+            }
+            break;
+        case msg::SPRAY_APPROACH:
+            if (!valve_.resetting() && !valve_.target_pct() && pump_flow_l_min_) {
+                valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
+                valve_.move_to(valve_command_pct_, now_ns);
+                pid_.reset();
+            }
+            if (continuation_open_point_reached()) {
+                // Open even if the valve is not there yet: late is better than never.
+                continuing_ = true;
+                continuation_on_target_ = false;
+                if (locator_.target()) publish_event(msg::SPRAY_RESUMED, *locator_.target(), now_ns);
+                open_sections(now_ns);
+                enter(msg::SPRAY_REGULATING, now_ns);
+            }
+            break;
+    }
+    valve_.update(now_ns);
+    actuators_.ball_valve_forward = valve_.drive() == RelayDrive::forward;
+    actuators_.ball_valve_reverse = valve_.drive() == RelayDrive::reverse;
+
+    TimeNs next = next_pid_ns_;
+    next = std::min(next, valve_.next_event_ns());
+    return next;
+}
+
+// ------------------------------------------------------------------ outputs
+
+io::ControllerIndicators SprayController::indicators() const {
+    io::ControllerIndicators indicators;
+    indicators.breakpoints_stored = stored_count_;
+    indicators.breakpoints_reached = reached_count_;
+    indicators.breakpoint_pending = locator_.target().has_value();
+    indicators.odometer_active = locator_.odometer_active();
+    return indicators;
+}
+
+std::vector<msg::BreakpointEvent> SprayController::take_events() {
+    std::vector<msg::BreakpointEvent> out;
+    out.swap(events_);
+    return out;
+}
+
+std::vector<std::string> SprayController::take_notices() {
+    std::vector<std::string> out;
+    out.swap(notices_);
+    return out;
+}
+
+msg::ControllerStatus SprayController::status(TimeNs now_ns) const {
+    msg::ControllerStatus status;
+    status.time_ns(now_ns);
+    status.positioning_mode(config_.positioning == Positioning::fusion ? msg::RTK_ODOMETER_FUSION : msg::RTK_ONLY);
+    status.breakpoint_pending(locator_.target().has_value());
+    status.odometer_active(locator_.odometer_active());
+    status.nozzle_to_breakpoint_m(locator_.nozzle_to_breakpoint_m().value_or(kNaN));
+    status.speed_km_h(speed_m_s() * 3.6);
+    status.l4_m(locator_.l4_m());
+    status.gnss_fix_quality(static_cast<std::uint16_t>(last_quality_));
+    status.nmea_rejected_count(rejected_sentences_);
+    status.spray_phase(phase_);
+    status.target_flow_l_min(config_.target_flow_l_min);
+    status.measured_flow_l_min(flow_meter_.flow_l_min().value_or(kNaN));
+    status.pump_flow_l_min(pump_flow_l_min_.value_or(kNaN));
+    status.valve_opening_estimate_pct(valve_.believed_opening_pct());
+    status.valve_opening_command_pct(valve_command_pct_);
+    status.boom_height_m(linkage_rise_m_);
+    return status;
+}
+
+}  // namespace rig::controller

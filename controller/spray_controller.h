@@ -1,0 +1,149 @@
+#pragma once
+// The reference controller's firmware logic (seed 000 sec. 2.2, Fig. 2), free of
+// any wire: it is fed the board's inputs with the time they were read, and says
+// what the outputs are. The DDS node (controller/reference_controller.h) and the
+// wired bench mode (serial NMEA + Modbus) both drive this one class, so the
+// controller under test does not change with the wire (ros2_control's idea).
+//
+// Inputs                         Conversions
+//   NMEA sentences (RS232)         GGA/RMC -> fix, course            (nmea_parser.h)
+//   land-wheel encoder count       Eq. 5 speed, odometer            (breakpoint_equations.h)
+//   KF11 pulse count               Eq. 3 main flow                  (flow_rate_meter.h)
+//   pump-outlet sensor voltage     Eq. 8 pump flow                  (flow_equations.h)
+//   boom-height sensor voltage     h -> Eq. 6 L4                    (flow_equations.h)
+//   breakpoint button, spray switch
+// Outputs: ball-valve relays, section valves, unloading valve; breakpoint events;
+// status.
+//
+// The spray sequence (SprayPhase in idl/controller.idl):
+//   VALVE_RESET  at start: valve open 5 s, back 2 s (a known position);
+//   IDLE         spray switch off: sections closed, unloading open;
+//   PRE_ADJUST   valve to the opening the calibration predicts for the target
+//                (ValveCalibration::opening_for), sections closed until the
+//                valve is there and the sprayer moves (zero-speed shutoff);
+//   REGULATING   sections open, unloading closed; once the measured flow has
+//                settled, the PID of Eq. 2 every period trims the opening;
+//   HALTED       the breakpoint button stored a breakpoint: spraying stops
+//                until the continuation;
+//   APPROACH     the sprayer approaches the stored breakpoint: valve reset,
+//                pre-adjustment, and the sections open when the odometer says
+//                the nozzle line is v (t2 + t3) short of it (Eq. 7; at it when
+//                hysteresis_compensation is off); then REGULATING, and the
+//                breakpoint is cleared once the flow is on target (and reached).
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "controller/breakpoint_locator.h"
+#include "controller/breakpoint_store.h"
+#include "controller/controller_config.h"
+#include "controller/flow_pid.h"
+#include "controller/flow_rate_meter.h"
+#include "controller/valve_calibration.h"
+#include "controller/valve_driver.h"
+#include "controllerPubSubTypes.h"
+#include "rig/clock.h"
+#include "rig/io_image.h"
+
+namespace rig::controller {
+
+class SprayController {
+public:
+    // Loads the breakpoint store from state_dir (a corrupt store throws, before time starts).
+    SprayController(ControllerConfig config, const std::filesystem::path& state_dir);
+
+    // Time starts: begins the valve reset.
+    void start(TimeNs now_ns);
+
+    // ---- inputs, each with the instant it was read
+    void on_nmea_sentence(const std::string& line, TimeNs now_ns);
+    void on_encoder_count(std::uint32_t count_pulses, TimeNs now_ns);
+    // The capture timer value at the last edge (1 MHz) when the wire carries it.
+    void on_flow_meter_count(std::uint32_t count_pulses, std::optional<std::uint32_t> last_edge_capture_us,
+                             TimeNs now_ns);
+    void on_pump_sensor_voltage(double voltage_v, TimeNs now_ns);
+    void on_boom_height_voltage(double voltage_v, TimeNs now_ns);
+    void on_breakpoint_button(bool closed, TimeNs now_ns);
+    void on_spray_switch(bool closed, TimeNs now_ns);
+
+    // Does the work due at now (the sequence, the PID, the valve relays) and
+    // returns when it must run again even without input.
+    TimeNs update(TimeNs now_ns);
+
+    // ---- outputs
+    const io::ActuatorCommands& actuators() const { return actuators_; }
+    io::ControllerIndicators indicators() const;
+    // Breakpoint events since the last call, in order.
+    std::vector<msg::BreakpointEvent> take_events();
+    msg::ControllerStatus status(TimeNs now_ns) const;
+    msg::SprayPhase phase() const { return phase_; }
+    // Sentences that failed parsing or their checksum.
+    std::uint32_t rejected_sentences() const { return rejected_sentences_; }
+    // Messages for the operator (e.g. "button pressed without a fix"), since the last call.
+    std::vector<std::string> take_notices();
+
+private:
+    void handle_fix_complete(TimeNs now_ns);
+    void on_locator_event(LocatorEvent event, TimeNs now_ns);
+    void store_breakpoint_here(TimeNs now_ns);
+    void clear_breakpoint(TimeNs now_ns);
+    void select_target();
+    void publish_event(msg::BreakpointEventKind kind, const StoredBreakpoint& breakpoint, TimeNs now_ns);
+    double speed_m_s() const;
+    bool moving_fast_enough() const;
+    std::uint16_t all_sections_mask() const;
+
+    void enter(msg::SprayPhase phase, TimeNs now_ns);
+    void open_sections(TimeNs now_ns);
+    void close_sections(TimeNs now_ns);
+    void start_pre_adjust(TimeNs now_ns);
+    void regulate(TimeNs now_ns);
+    bool continuation_open_point_reached() const;
+
+    ControllerConfig config_;
+    BreakpointStore store_;
+    BreakpointLocator locator_;
+    ValveCalibration calibration_;
+    ValveDriver valve_;
+    FlowPid pid_;
+    FlowRateMeter flow_meter_;
+
+    // GNSS, assembled from GGA (position, quality) and RMC (course).
+    std::optional<FixInput> last_fix_;
+    std::optional<double> last_course_deg_;  // kept while standing (RMC course is empty then)
+    int last_quality_ = 0;
+    std::uint32_t rejected_sentences_ = 0;
+
+    // Encoder samples within the Eq. 5 speed window: (time, count).
+    std::deque<std::pair<TimeNs, std::uint32_t>> encoder_window_;
+    std::optional<std::uint32_t> latest_count_;
+    bool button_closed_ = false;
+    bool spray_switch_on_ = false;
+    std::optional<double> pump_flow_l_min_;
+    TimeNs last_pump_sample_ns_ = 0;
+    double linkage_rise_m_;
+
+    msg::SprayPhase phase_ = msg::SPRAY_VALVE_RESET;
+    io::ActuatorCommands actuators_{};
+    bool halted_ = false;                 // a stored breakpoint waits for its continuation
+    bool continuing_ = false;             // this regulating episode is a continuation
+    bool reached_ = false;                // the locator said the nozzle line is at the breakpoint
+    TimeNs sections_opened_ns_ = 0;
+    bool flow_established_ = false;
+    std::optional<double> previous_measurement_l_min_;
+    std::optional<TimeNs> on_target_since_ns_;
+    bool continuation_on_target_ = false;
+    double valve_command_pct_ = 0.0;
+    TimeNs next_pid_ns_ = 0;
+    bool started_ = false;
+
+    std::vector<msg::BreakpointEvent> events_;
+    std::vector<std::string> notices_;
+    std::uint16_t stored_count_ = 0;
+    std::uint16_t reached_count_ = 0;
+};
+
+}  // namespace rig::controller

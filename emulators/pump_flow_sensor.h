@@ -1,0 +1,48 @@
+#pragma once
+// The pump-outlet flow sensor (seed 000 sec. 2.4.2, Eq. 8): a 4-20 mA transmitter
+// over 0..full_scale_m3_h, through a current-to-voltage module to 0-3.3 V at an
+// ADC pin of the board. Publishes the pin voltage at a fixed rate.
+//
+//   I = 4 mA + 16 mA x Q / Q_F          (saturates at 20 mA above full scale)
+//   V = (I - 4 mA) / 16 mA x 3.3 V       (the module maps the 16 mA span onto u = 3.3 V)
+//
+// The controller inverts it with Eq. 8. Faults: noise_mv (ADC and wiring noise,
+// Gaussian, seeded), offset_ma (a transmitter zero error).
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "emulators/seeded_random.h"
+#include "emulators/spray_circuit.h"
+#include "rig/dds_context.h"
+#include "rig/node.h"
+
+namespace rig::emulators {
+
+struct PumpFlowSensorParams {
+    double full_scale_m3_h = 6.0;   // Q_F: 100 L/min, above the pump's 81 L/min
+    double noise_mv = 2.0;
+    double offset_ma = 0.0;
+    double rate_hz = 20.0;
+    std::uint64_t seed = 1;
+};
+
+class PumpFlowSensor final : public Node {
+public:
+    PumpFlowSensor(SprayCircuit& circuit, PumpFlowSensorParams params);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    // The pin voltage for a pump flow, without noise (the transfer function above).
+    double voltage_for(double pump_flow_l_min) const;
+
+private:
+    std::string name_ = "pump_flow_sensor";
+    SprayCircuit& circuit_;
+    PumpFlowSensorParams params_;
+    SeededRandom noise_;
+    TimeNs period_ns_;
+    std::unique_ptr<Writer<msg::AnalogInput>> voltage_writer_;
+};
+
+}  // namespace rig::emulators
