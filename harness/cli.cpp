@@ -2,6 +2,7 @@
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
 //   rig nmea decode FILE|-
 //   rig dds-check [--samples N] [--log-dir DIR]
+//   rig modbus serve [--tcp ADDRESS:PORT | --rtu DEVICE ...] [synthetic signal options]
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <unistd.h>
 
 #include "controller/nmea_decode_tool.h"
+#include "harness/bench_modbus.h"
 #include "harness/case_runner.h"
 #include "harness/results_writer.h"
 #include "rig/clock.h"
@@ -102,12 +104,18 @@ int main(int argc, char** argv) {
     check->add_flag("--echo", check_echo, "internal: be the echo side")->group("");
     check->add_option("--domain", check_domain, "internal: the echo side's domain")->group("");
 
+    rig::harness::ModbusServeOptions modbus_serve_options;
+    auto* modbus = app.add_subcommand("modbus", "Modbus bench wire tools");
+    modbus->require_subcommand(1);
+    auto* modbus_serve = rig::harness::add_modbus_serve_subcommand(*modbus, modbus_serve_options);
+
     CLI11_PARSE(app, argc, argv);
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
     }
     if (decode->parsed()) return nmea_decode_command(nmea_input);
+    if (modbus_serve->parsed()) return rig::harness::run_modbus_serve_command(modbus_serve_options);
     if (check->parsed()) {
         try {
             if (check_echo) return rig::run_dds_echo(check_domain, check_options.samples, std::cout);
