@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "controller/nmea_decode_tool.h"
+#include "harness/bench_serial.h"
 #include "harness/case_runner.h"
 #include "harness/results_writer.h"
 #include "rig/clock.h"
@@ -90,6 +91,9 @@ int main(int argc, char** argv) {
     auto* decode = nmea->add_subcommand("decode", "decode NMEA lines with the controller's parser, one JSON per line");
     decode->add_option("input", nmea_input, "file, or - for standard input")->required();
 
+    // Bench wire adapters: `rig pty` (harness/bench_serial.h).
+    const rig::harness::PtyBenchCommand pty_bench(app);
+
     rig::DdsCheckOptions check_options;
     check_options.echo_executable = own_directory() / "rig";
     check_options.log_dir = std::filesystem::temp_directory_path();
@@ -103,6 +107,7 @@ int main(int argc, char** argv) {
     check->add_option("--domain", check_domain, "internal: the echo side's domain")->group("");
 
     CLI11_PARSE(app, argc, argv);
+    if (pty_bench.parsed()) return pty_bench.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
