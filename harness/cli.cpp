@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "controller/nmea_decode_tool.h"
+#include "harness/bench_hid.h"
 #include "harness/bench_serial.h"
 #include "harness/case_runner.h"
 #include "harness/results_writer.h"
@@ -91,8 +92,9 @@ int main(int argc, char** argv) {
     auto* decode = nmea->add_subcommand("decode", "decode NMEA lines with the controller's parser, one JSON per line");
     decode->add_option("input", nmea_input, "file, or - for standard input")->required();
 
-    // Bench wire adapters: `rig pty` (harness/bench_serial.h).
+    // Bench wire adapters: `rig pty`, `rig hid list` (harness/bench_serial.h, harness/bench_hid.h).
     const rig::harness::PtyBenchCommand pty_bench(app);
+    const rig::harness::HidBenchCommand hid_bench(app);
 
     rig::DdsCheckOptions check_options;
     check_options.echo_executable = own_directory() / "rig";
@@ -108,6 +110,7 @@ int main(int argc, char** argv) {
 
     CLI11_PARSE(app, argc, argv);
     if (pty_bench.parsed()) return pty_bench.run();
+    if (hid_bench.parsed()) return hid_bench.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
