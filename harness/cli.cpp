@@ -10,7 +10,9 @@
 #include <unistd.h>
 
 #include "controller/nmea_decode_tool.h"
+#include "harness/bench_hid.h"
 #include "harness/bench_modbus.h"
+#include "harness/bench_serial.h"
 #include "harness/case_runner.h"
 #include "harness/results_writer.h"
 #include "rig/clock.h"
@@ -92,6 +94,10 @@ int main(int argc, char** argv) {
     auto* decode = nmea->add_subcommand("decode", "decode NMEA lines with the controller's parser, one JSON per line");
     decode->add_option("input", nmea_input, "file, or - for standard input")->required();
 
+    // Bench wire adapters: `rig pty`, `rig hid list` (harness/bench_serial.h, harness/bench_hid.h).
+    const rig::harness::PtyBenchCommand pty_bench(app);
+    const rig::harness::HidBenchCommand hid_bench(app);
+
     rig::DdsCheckOptions check_options;
     check_options.echo_executable = own_directory() / "rig";
     check_options.log_dir = std::filesystem::temp_directory_path();
@@ -110,6 +116,8 @@ int main(int argc, char** argv) {
     auto* modbus_serve = rig::harness::add_modbus_serve_subcommand(*modbus, modbus_serve_options);
 
     CLI11_PARSE(app, argc, argv);
+    if (pty_bench.parsed()) return pty_bench.run();
+    if (hid_bench.parsed()) return hid_bench.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
