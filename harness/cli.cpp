@@ -14,6 +14,7 @@
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
 #include "harness/case_runner.h"
+#include "harness/html_report.h"
 #include "harness/results_writer.h"
 #include "rig/clock.h"
 #include "rig/config_error.h"
@@ -54,10 +55,15 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     const auto results = run_cases(specs, options, std::cerr);
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
-    write_results(options.out_dir, results, summary);
+    // No figures are recorded yet: report.html has the tables and the suite charts.
+    const std::vector<CaseFigures> figures(results.size());
+    const std::vector<std::string> report_problems =
+        write_results(options.out_dir, results, summary, figures, HtmlReportOptions{});
     std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    for (const std::string& problem : report_problems) std::cerr << "rig: report: " << problem << "\n";
     std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
-              << (options.out_dir / "report.txt").string() << "\n";
+              << (options.out_dir / "report.txt").string() << ", " << (options.out_dir / "report.html").string()
+              << "\n";
     return summary.failed == 0 ? 0 : 1;
 }
 

@@ -13,6 +13,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "harness/html_report.h"
+
 namespace rig::harness {
 
 namespace {
@@ -127,6 +129,8 @@ bool allowed_in_xml(char32_t c) {
            (c >= 0x10000 && c <= 0x10FFFF);
 }
 
+}  // namespace
+
 // The text with malformed UTF-8 replaced by U+FFFD (nlohmann::json refuses to
 // dump invalid UTF-8, and error text may come from a crashed child's output).
 std::string valid_utf8(std::string_view text) {
@@ -161,6 +165,8 @@ std::string xml_escape(std::string_view text, bool attribute) {
     }
     return out;
 }
+
+namespace {
 
 std::string join_lines(const std::vector<std::string>& lines) {
     std::string text;
@@ -233,6 +239,8 @@ const char* status_color(const std::string& status) {
 constexpr const char* kColorFailure = "\033[31m";
 constexpr const char* kColorReset = "\033[0m";
 
+}  // namespace
+
 // ---------------------------------------------------------------- files
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& content) {
@@ -262,8 +270,6 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
         throw std::filesystem::filesystem_error("cannot move results into place", temporary, path, rename_error);
     }
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------- judging
 
@@ -505,6 +511,19 @@ void write_results(const std::filesystem::path& out_dir, const std::vector<CaseR
     write_file_atomically(out_dir / "results.json", json_text);
     write_file_atomically(out_dir / "junit.xml", junit_xml(results, summary));
     write_file_atomically(out_dir / "report.txt", result_report(results, summary));
+}
+
+std::vector<std::string> write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
+                                       const RunSummary& summary, const std::vector<CaseFigures>& figures,
+                                       const HtmlReportOptions& options) {
+    write_results(out_dir, results, summary);
+    // The human report is a view: whatever goes wrong with it is told, never a
+    // reason to fail (or crash) a run whose results are already written.
+    try {
+        return write_html_report(out_dir / "report.html", results, figures, summary, options);
+    } catch (const std::exception& error) {
+        return {std::string("report.html not written: ") + error.what()};
+    }
 }
 
 }  // namespace rig::harness

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rig::harness {
@@ -97,5 +98,31 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
 // half-written file. Throws std::runtime_error / std::filesystem::filesystem_error.
 void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
                    const RunSummary& summary);
+
+struct CaseFigures;        // harness/html_report.h
+struct HtmlReportOptions;  // harness/html_report.h
+
+// The same, plus out_dir/report.html with figures (figures[i] belongs to
+// results[i]; see write_html_report). A problem with report.html (gnuplot
+// missing or failing, the file not writable) never throws: it is returned,
+// one line per problem, for the caller to print; empty when all went well.
+// Problems with the other three files throw as above.
+std::vector<std::string> write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
+                                       const RunSummary& summary, const std::vector<CaseFigures>& figures,
+                                       const HtmlReportOptions& options);
+
+// ------------------------------------------------------------------ text and files (shared with html_report)
+
+// The text with malformed UTF-8 replaced by U+FFFD (nlohmann::json refuses to
+// dump invalid UTF-8, and error text may come from a crashed child's output).
+std::string valid_utf8(std::string_view text);
+
+// Escapes for XML (and so XHTML) element text, or for a double-quoted attribute
+// value; malformed UTF-8 and characters XML 1.0 forbids become U+FFFD.
+std::string xml_escape(std::string_view text, bool attribute);
+
+// Writes the file through a temporary beside it renamed into place, so a reader
+// never sees a half-written file. Throws std::runtime_error / filesystem_error.
+void write_file_atomically(const std::filesystem::path& path, const std::string& content);
 
 }  // namespace rig::harness
