@@ -61,6 +61,7 @@ WriterBase::~WriterBase() {
 bool WriterBase::write_raw(void* sample) {
     undelivered_.store(true);
     if (!writer_->write(sample)) return false;
+    written_.fetch_add(1);
     if (counts_as_output_) context_.note_published();
     return true;
 }
@@ -74,10 +75,13 @@ bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
     return true;
 }
 
+void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.notify_data_arrived(); }
+
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
-    : context_(context), topic_name_(std::move(topic_name)) {
-    reader_ = context_.subscriber().create_datareader(topic, project_reader_qos(context_.subscriber()), &listener_,
-                                                      dds::StatusMask::subscription_matched());
+    : context_(context), topic_name_(std::move(topic_name)), listener_(context) {
+    reader_ = context_.subscriber().create_datareader(
+        topic, project_reader_qos(context_.subscriber()), &listener_,
+        dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
     if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
     context_.register_reader(this);
 }
@@ -97,9 +101,20 @@ bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
 bool ReaderBase::take_raw(void* sample) {
     dds::SampleInfo info;
     while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
-        if (info.valid_data) return true;  // skip dispose / unregister notifications
+        if (info.valid_data) {
+            taken_.fetch_add(1);
+            return true;
+        }
+        // Dispose / unregister notifications are not samples; nobody writes them here.
     }
     return false;
+}
+
+std::uint64_t ReaderBase::received_count() const {
+    // Read the unread count first: a sample taken in between is then counted in
+    // neither, never twice (the count can only be low, and the waiter re-checks).
+    const std::uint64_t unread = reader_->get_unread_count();
+    return taken_.load() + unread;
 }
 
 DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name) : domain_id_(domain_id) {
@@ -129,15 +144,40 @@ dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*ma
     return topic;
 }
 
-std::vector<std::string> DdsContext::wait_delivered_where(std::chrono::milliseconds timeout,
-                                                          const std::function<bool(const std::string&)>& needs_wait) {
-    std::vector<std::string> late;
+std::map<std::string, std::uint64_t> DdsContext::written_counts() const {
+    std::map<std::string, std::uint64_t> counts;
     for (WriterBase* writer : writers()) {
-        if (writer->has_undelivered() && needs_wait(writer->topic_name()) && !writer->wait_delivered(timeout)) {
-            late.push_back(writer->topic_name());
-        }
+        if (writer->counts_as_output()) counts[writer->topic_name()] += writer->written_count();
     }
-    return late;
+    return counts;
+}
+
+void DdsContext::notify_data_arrived() {
+    {
+        std::lock_guard lock(arrival_mutex_);
+        ++arrivals_;
+    }
+    arrival_.notify_all();
+}
+
+std::vector<std::string> DdsContext::wait_received(const std::map<std::string, std::uint64_t>& expected,
+                                                   std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::vector<std::string> short_topics;
+    for (;;) {
+        std::unique_lock lock(arrival_mutex_);
+        const std::uint64_t seen = arrivals_;
+        lock.unlock();
+        short_topics.clear();
+        for (ReaderBase* reader : readers()) {
+            const auto it = expected.find(reader->topic_name());
+            if (it != expected.end() && reader->received_count() < it->second) short_topics.push_back(it->first);
+        }
+        if (short_topics.empty()) return short_topics;
+        lock.lock();
+        // Sleep until the next arrival (or the deadline); arrivals since `seen` wake us at once.
+        if (!arrival_.wait_until(lock, deadline, [&] { return arrivals_ != seen; })) return short_topics;
+    }
 }
 
 std::vector<std::string> DdsContext::wait_all_delivered(std::chrono::milliseconds timeout) {

@@ -5,8 +5,8 @@
 // needs every sample delivered before a tick is acknowledged.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -46,6 +46,9 @@ public:
     bool wait_delivered(std::chrono::milliseconds timeout);
     // Written to since the last successful wait_delivered() (only those need waiting for).
     bool has_undelivered() const { return undelivered_.load(); }
+    // Samples written since the writer was created.
+    std::uint64_t written_count() const { return written_.load(); }
+    bool counts_as_output() const { return counts_as_output_; }
 
 protected:
     WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output);
@@ -64,6 +67,7 @@ private:
     dds::DataWriter* writer_ = nullptr;
     bool counts_as_output_;
     std::atomic<bool> undelivered_{false};
+    std::atomic<std::uint64_t> written_{0};
 };
 
 // A typed writer on one topic. Each publish() is counted by the context, which is
@@ -88,6 +92,8 @@ public:
     const std::string& topic_name() const { return topic_name_; }
     int matched_writers() const { return listener_.matched.load(); }
     bool has_unread() const { return reader_->get_unread_count() > 0; }
+    // Samples that have arrived since the reader was created (taken or not).
+    std::uint64_t received_count() const;
     // Blocks (wall time) until a sample is available or the timeout passes.
     bool wait_for_data(std::chrono::milliseconds timeout);
 
@@ -98,15 +104,19 @@ protected:
 
 private:
     struct MatchListener : dds::DataReaderListener {
+        explicit MatchListener(DdsContext& owner) : context(owner) {}
+        DdsContext& context;
         std::atomic<int> matched{0};
         void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
             matched.store(status.current_count);
         }
+        void on_data_available(dds::DataReader*) override;
     };
     DdsContext& context_;
     std::string topic_name_;
     MatchListener listener_;
     dds::DataReader* reader_ = nullptr;
+    std::atomic<std::uint64_t> taken_{0};
 };
 
 // A typed reader: take_all() returns every received sample in arrival order
@@ -145,12 +155,20 @@ public:
     std::uint32_t take_published_count() { return published_count_.exchange(0); }
     void note_published() { published_count_.fetch_add(1); }
 
+    // Per topic, the samples this process's output writers have written so far
+    // (the lockstep clock's own writers do not count).
+    std::map<std::string, std::uint64_t> written_counts() const;
+    // Waits until every reader of a topic in `expected` has received at least that
+    // many samples on it (counted delivery, rig/lockstep.h). Returns the topics
+    // still short when the timeout passes (empty = all there).
+    std::vector<std::string> wait_received(const std::map<std::string, std::uint64_t>& expected,
+                                           std::chrono::milliseconds timeout);
+    // Called by readers when data arrives (wakes wait_received).
+    void notify_data_arrived();
+
     // Waits until every writer's samples are acknowledged by all matched readers.
     // Returns the topics that did not make it in time (empty = all delivered).
     std::vector<std::string> wait_all_delivered(std::chrono::milliseconds timeout);
-    // Only the writers for which `needs_wait(topic)` is true.
-    std::vector<std::string> wait_delivered_where(std::chrono::milliseconds timeout,
-                                                  const std::function<bool(const std::string&)>& needs_wait);
 
     // Registry used by wait_all_delivered and endpoint-matching checks.
     void register_writer(WriterBase* writer);
@@ -172,6 +190,9 @@ private:
     mutable std::mutex registry_mutex_;
     std::vector<WriterBase*> writers_;
     std::vector<ReaderBase*> readers_;
+    std::mutex arrival_mutex_;
+    std::condition_variable arrival_;
+    std::uint64_t arrivals_ = 0;
 };
 
 template <class Msg>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <iostream>
 #include <set>
+#include <map>
 #include <sstream>
 
 #include "idl/topics.h"
@@ -25,6 +26,44 @@ std::vector<std::string> split_topics(const std::string& joined) {
     return topics;
 }
 
+using TopicCounts = std::map<std::string, std::uint64_t>;
+
+// idl/clock.idl bounds the list (32 topics, names of 64 characters): the clock
+// samples stay small enough for Fast DDS to deliver them in one message over
+// shared memory (at 64 x 128 they were not delivered at all).
+constexpr std::size_t kMaxCountedTopics = 32;
+constexpr std::size_t kMaxTopicNameLength = 64;
+
+void fill_counts(const TopicCounts& counts, std::vector<msg::TopicCount>& out) {
+    if (counts.size() > kMaxCountedTopics) {
+        throw std::length_error("lockstep: " + std::to_string(counts.size()) + " topics carry samples, the clock can count " +
+                                std::to_string(kMaxCountedTopics) + " (idl/clock.idl)");
+    }
+    out.clear();
+    for (const auto& [topic, samples] : counts) {
+        if (topic.size() > kMaxTopicNameLength) {
+            throw std::length_error("lockstep: topic name '" + topic + "' is longer than " +
+                                    std::to_string(kMaxTopicNameLength) + " characters (idl/clock.idl)");
+        }
+        msg::TopicCount count;
+        count.topic(topic);
+        count.samples(samples);
+        out.push_back(count);
+    }
+}
+
+TopicCounts read_counts(const std::vector<msg::TopicCount>& in) {
+    TopicCounts counts;
+    for (const msg::TopicCount& count : in) counts[count.topic().to_string()] = count.samples();
+    return counts;
+}
+
+std::string join(const std::vector<std::string>& items) {
+    std::string joined;
+    for (const auto& item : items) joined += (joined.empty() ? "" : ", ") + item;
+    return joined;
+}
+
 std::string format_time(TimeNs t) {
     std::ostringstream out;
     out.setf(std::ios::fixed);
@@ -42,7 +81,7 @@ LockstepMaster::~LockstepMaster() { shutdown(); }
 void LockstepMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0}); }
 
 void LockstepMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
-    remotes_.push_back(Remote{name, std::move(liveness), 0, {}});
+    remotes_.push_back(Remote{name, std::move(liveness), 0, {}, {}});
 }
 
 void LockstepMaster::start() {
@@ -93,25 +132,32 @@ void LockstepMaster::start() {
     started_ = true;
 }
 
-void LockstepMaster::wait_local_delivery(TimeNs t) {
-    // In slices, so a reader that died is reported as such rather than as slow.
+LockstepMaster::TopicCounts LockstepMaster::all_published_counts() const {
+    TopicCounts totals = dds_.written_counts();
+    for (const Remote& remote : remotes_) {
+        for (const auto& [topic, samples] : remote.published_counts) totals[topic] += samples;
+    }
+    return totals;
+}
+
+void LockstepMaster::wait_local_readers(TimeNs t) {
+    // In slices, so a remote that died is reported as such rather than as slow.
+    const TopicCounts expected = all_published_counts();
     const WallStopwatch waited;
     for (;;) {
-        const auto late = dds_.wait_all_delivered(kPollSlice);
-        if (late.empty()) return;
+        const auto short_topics = dds_.wait_received(expected, kPollSlice);
+        if (short_topics.empty()) return;
         for (const Remote& remote : remotes_) {
             if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) {
                 throw NodeFailure(remote.name, *gone + " (at t=" + format_time(t) + ")");
             }
         }
         if (waited.elapsed() > timeouts_.delivery) {
-            std::string topics;
-            for (const auto& topic : late) topics += (topics.empty() ? "" : ", ") + topic;
-            std::string readers;
-            for (const Remote& remote : remotes_) readers += (readers.empty() ? "" : ", ") + remote.name;
-            throw NodeFailure(readers.empty() ? "harness" : readers,
-                              "did not acknowledge samples on " + topics + " at t=" + format_time(t) + " within " +
-                                  std::to_string(timeouts_.delivery.count()) + " ms");
+            std::string writers;
+            for (const Remote& remote : remotes_) writers += (writers.empty() ? "" : ", ") + remote.name;
+            throw NodeFailure(writers.empty() ? "harness" : writers,
+                              "samples on " + join(short_topics) + " did not arrive at the harness at t=" +
+                                  format_time(t) + " within " + std::to_string(timeouts_.delivery.count()) + " ms");
         }
     }
 }
@@ -121,6 +167,7 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
     tick.seq(seq_);
     tick.time_ns(t);
     tick.shutdown(shutdown);
+    fill_counts(all_published_counts(), tick.published_counts());
     const std::uint64_t seq = seq_++;
     tick_writer_->publish(tick);
 
@@ -140,6 +187,7 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
                 answered[i] = true;
                 --outstanding;
                 remotes_[i].next_wake_ns = ack.next_wake_ns();
+                remotes_[i].published_counts = read_counts(ack.published_counts());
                 published += ack.published_count();
                 if (hello) remotes_[i].subscribed_topics = split_topics(ack.subscribed_topics().to_string());
             }
@@ -182,15 +230,19 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
             const bool due = round == 0 && local.next_wake_ns <= t;
             if (due || local.node->has_unread_input()) local.next_wake_ns = local.node->step(t);
         }
-        wait_local_delivery(t);
         const std::uint32_t published_by_locals = dds_.take_published_count();
 
         bool remote_due = false;
         for (const Remote& remote : remotes_) remote_due |= round == 0 && remote.next_wake_ns <= t;
         published_by_remotes = 0;
         if (!remotes_.empty() && (remote_due || published_by_locals > 0)) {
+            // The tick carries the published counts; each remote waits for its
+            // readers to hold them before it steps.
             published_by_remotes = tick_remotes(t, false);
         }
+        // Local readers (the trace, local nodes) hold everything published at t,
+        // here and in the remotes, before the round ends.
+        wait_local_readers(t);
         if (after_round_) after_round_(t, round);
         if (published_by_remotes == 0) {
             // Local nodes may still hold input that arrived from other local nodes.
@@ -240,6 +292,7 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
         ack.seq(seq);
         ack.next_wake_ns(next_wake);
         ack.published_count(published);
+        fill_counts(dds.written_counts(), ack.published_counts());
         ack.subscribed_topics(topics);
         ack.fatal_error(fatal.substr(0, 1000));
         ack_writer->publish(ack);
@@ -296,6 +349,19 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
                 return 0;
             }
             clock.set_ns(tick.time_ns());
+            // Counted delivery: everything published so far must be in our readers
+            // before we take our inputs (a sample published at t is seen at t).
+            if (const auto short_topics = dds.wait_received(read_counts(tick.published_counts()),
+                                                           options.delivery_timeout);
+                !short_topics.empty()) {
+                const std::string problem = "samples on " + join(short_topics) + " published by t=" +
+                                            format_time(tick.time_ns()) + " did not arrive within " +
+                                            std::to_string(options.delivery_timeout.count()) + " ms";
+                send_ack(tick.seq(), kNever, 0, "", problem);
+                ack_writer->wait_delivered(options.delivery_timeout);
+                std::cerr << options.node_name << ": " << problem << "\n";
+                return 5;
+            }
             dds.take_published_count();
             TimeNs next_wake = kNever;
             try {
@@ -309,11 +375,6 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
                 ack_writer->wait_delivered(options.delivery_timeout);
                 std::cerr << options.node_name << ": " << error.what() << "\n";
                 return 2;
-            }
-            const auto late = dds.wait_all_delivered(options.delivery_timeout);
-            if (!late.empty()) {
-                send_ack(tick.seq(), kNever, 0, "", "samples on " + late.front() + " not acknowledged in time");
-                return 5;
             }
             send_ack(tick.seq(), next_wake, dds.take_published_count(), "", "");
         }
