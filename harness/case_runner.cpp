@@ -218,10 +218,10 @@ std::optional<FlowEpisode> judged_episode(const TraceRecorder& trace, TimeNs fro
     return episode;
 }
 
-std::vector<FlowSample> main_flow_samples(const TraceRecorder& trace) {
-    std::vector<FlowSample> samples;
+std::vector<MainFlowSample> main_flow_samples(const TraceRecorder& trace) {
+    std::vector<MainFlowSample> samples;
     for (const auto& [t, sample] : trace.samples(topics::kHydraulicsTruth)) {
-        samples.push_back(FlowSample{t, sample.at("main_flow_l_min").get<double>()});
+        samples.push_back(MainFlowSample{t, sample.at("main_flow_l_min").get<double>()});
     }
     return samples;
 }
@@ -246,6 +246,48 @@ void add_spray_timing_metrics(const TraceRecorder& trace, const emulators::Spray
     }
 }
 
+// Fig. 14: main flow (truth) and the controller's Eq. 3 reading, against the
+// nozzle line's distance to the breakpoint, around the judged episode.
+void add_flow_figure(const TraceRecorder& trace, const emulators::Plant& plant, const FlowEpisode& episode,
+                     double breakpoint_along_m, CaseFigures& figures) {
+    const TimeNs from_ns = episode.open_command_ns - seconds_to_ns(1.0);
+    const TimeNs to_ns = std::min(episode.end_ns, episode.open_command_ns + seconds_to_ns(8.0));
+    std::map<TimeNs, double> measured;
+    for (const auto& [t, status] : trace.samples(topics::kControllerStatus)) {
+        if (t >= from_ns && t <= to_ns && status.at("measured_flow_l_min").is_number()) {
+            measured[t] = status.at("measured_flow_l_min").get<double>();
+        }
+    }
+    for (const auto& [t, sample] : trace.samples(topics::kHydraulicsTruth)) {
+        if (t < from_ns || t > to_ns) continue;
+        FlowSample point;
+        point.t_s = ns_to_seconds(t);
+        point.distance_to_breakpoint_m = plant.truth_at(t).nozzle_line_along_m() - breakpoint_along_m;
+        point.main_flow_l_min = sample.at("main_flow_l_min").get<double>();
+        if (const auto it = measured.find(t); it != measured.end()) point.measured_flow_l_min = it->second;
+        figures.flow.push_back(point);
+    }
+}
+
+// Fig. 15: dose per row across the breakpoint, by pass, with the judged areas.
+void add_dose_figure(const DoseProfile& profile, const DepositionResult& deposition, double breakpoint_along_m,
+                     double window_m, CaseFigures& figures) {
+    double from_m = breakpoint_along_m - 2.0 * window_m;
+    double to_m = breakpoint_along_m + 2.0 * window_m;
+    for (const AreaSpan& area : deposition.areas) {
+        from_m = std::min(from_m, area.from_along_m - 1.0);
+        to_m = std::max(to_m, area.to_along_m + 1.0);
+    }
+    const std::size_t rows = std::max(profile.first_pass.size(), profile.continuation.size());
+    for (std::size_t row = 0; row < rows; ++row) {
+        const double along_m = profile.row_centre_m(row);
+        if (along_m < from_m || along_m > to_m) continue;
+        figures.dose.push_back(DoseSample{along_m, row < profile.first_pass.size() ? profile.first_pass[row] : 0.0,
+                                          row < profile.continuation.size() ? profile.continuation[row] : 0.0});
+    }
+    figures.areas = deposition.areas;
+}
+
 DoseProfile dose_profile(const emulators::DepositionGrid& grid) {
     DoseProfile profile;
     profile.first_row_centre_m = grid.row_centre_m(0);
@@ -257,9 +299,11 @@ DoseProfile dose_profile(const emulators::DepositionGrid& grid) {
 
 }  // namespace
 
-CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
+CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
     const WallStopwatch wall;
-    CaseResult result;
+    CaseRun run;
+    CaseResult& result = run.result;
+    CaseFigures& figures = run.figures;
     result.name = spec.name;
     result.file = spec.source_path.string();
     result.seed = options.seed_override.value_or(spec.seed);
@@ -383,15 +427,19 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
             const double target = spec.controller.target_flow_l_min;
             const TimeNs judged_from_ns =
                 static_test ? 0 : seconds_to_ns(plant.vehicle().pass_start_s(plant.vehicle().pass_index_at(1e9)));
+            figures.target_flow_l_min = target;
             if (const auto episode = judged_episode(trace, judged_from_ns, end_ns)) {
                 for (const auto& [name, value] : flow_metrics(main_flow_samples(trace), *episode, target)) {
                     result.metrics[name] = value;
                 }
+                const double open_at_m = plant.truth_at(episode->open_command_ns).nozzle_line_along_m();
                 if (!static_test) {
                     // Where the flow adjustment began, before the breakpoint (paper: 1.70 / 2.55 / 3.45 m).
-                    const double open_at_m = plant.truth_at(episode->open_command_ns).nozzle_line_along_m();
                     result.metrics["flow_adjust_start_before_breakpoint_m"] = spec.breakpoint.along_m - open_at_m;
                 }
+                add_flow_figure(trace, plant, *episode, spec.breakpoint.along_m, figures);
+                figures.section_open_command_distance_m = open_at_m - spec.breakpoint.along_m;
+                figures.section_open_command_t_s = ns_to_seconds(episode->open_command_ns);
             }
             add_spray_timing_metrics(trace, circuit, result.metrics);
         }
@@ -402,9 +450,10 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
             judging.sprayed_fraction = spec.deposition.sprayed_fraction;
             judging.cv_row_m = spec.deposition.cv_row_m;
             judging.cv_window_m = spec.deposition.cv_window_m;
-            const DepositionResult deposition =
-                deposition_metrics(dose_profile(circuit.deposition()), judging, spec.breakpoint.along_m);
+            const DoseProfile profile = dose_profile(circuit.deposition());
+            const DepositionResult deposition = deposition_metrics(profile, judging, spec.breakpoint.along_m);
             for (const auto& [name, value] : deposition.metrics) result.metrics[name] = value;
+            add_dose_figure(profile, deposition, spec.breakpoint.along_m, spec.deposition.cv_window_m, figures);
         }
     } catch (const std::exception& error) {
         result.error = error.what();
@@ -415,27 +464,28 @@ CaseResult run_case(const CaseSpec& spec, const RunOptions& options) {
     if (!result.error.empty()) result.failures.insert(result.failures.begin(), "error: " + result.error);
     result.expected_failure = verdict.expected_failure;
     result.passed = result.error.empty() && verdict.passed;
-    return result;
+    figures.breakpoint_along_m = spec.breakpoint.along_m;
+    return run;
 }
 
-std::vector<CaseResult> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options,
-                                  std::ostream& progress) {
-    std::vector<CaseResult> results(specs.size());
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress) {
+    std::vector<CaseRun> runs(specs.size());
     std::atomic<std::size_t> next{0};
     std::mutex progress_mutex;
     auto worker = [&] {
         for (std::size_t i = next++; i < specs.size(); i = next++) {
-            results[i] = run_case(specs[i], options);
+            runs[i] = run_case(specs[i], options);
+            const CaseResult& result = runs[i].result;
             std::lock_guard lock(progress_mutex);
-            progress << "rig: [" << (results[i].passed ? "PASS" : "FAIL") << "] " << results[i].name << " ("
-                     << results[i].wall_seconds << " s wall)\n";
+            progress << "rig: [" << (result.passed ? "PASS" : "FAIL") << "] " << result.name << " ("
+                     << result.wall_seconds << " s wall)\n";
         }
     };
     const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(specs.size())));
     std::vector<std::thread> threads;
     for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
     for (auto& thread : threads) thread.join();
-    return results;
+    return runs;
 }
 
 }  // namespace rig::harness

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "harness/case_spec.h"
+#include "harness/html_report.h"
 #include "harness/results_writer.h"
 
 namespace rig::harness {
@@ -25,11 +26,16 @@ struct RunOptions {
 // own parameters); throws rig::ConfigError naming file, line and key.
 void validate_for_run(const CaseSpec& spec, const RunOptions& options);
 
+// A case's verdict and what the report draws of it (Fig. 14 flow curve, Fig. 15 dose).
+struct CaseRun {
+    CaseResult result;
+    CaseFigures figures;
+};
+
 // Runs one case to the end (or to the first failure); never throws.
-CaseResult run_case(const CaseSpec& spec, const RunOptions& options);
+CaseRun run_case(const CaseSpec& spec, const RunOptions& options);
 
 // Runs cases `options.jobs` at a time, printing one progress line per case.
-std::vector<CaseResult> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options,
-                                  std::ostream& progress);
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress);
 
 }  // namespace rig::harness

@@ -52,11 +52,15 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         return 2;
     }
     const rig::WallStopwatch wall;
-    const auto results = run_cases(specs, options, std::cerr);
+    const auto runs = run_cases(specs, options, std::cerr);
+    std::vector<CaseResult> results;
+    std::vector<CaseFigures> figures;
+    for (const CaseRun& run : runs) {
+        results.push_back(run.result);
+        figures.push_back(run.figures);
+    }
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
-    // No figures are recorded yet: report.html has the tables and the suite charts.
-    const std::vector<CaseFigures> figures(results.size());
     const std::vector<std::string> report_problems =
         write_results(options.out_dir, results, summary, figures, HtmlReportOptions{});
     std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);

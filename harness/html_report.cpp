@@ -763,7 +763,7 @@ std::optional<Panel> dose_panel(const CaseFigures& figures, const std::vector<Do
     script += data_block("dose", data);
     // No title: the key takes its place above the plot, the figure's caption says the rest.
     script += "set xlabel " + gnuplot_string("along track (m)") + "\n";
-    script += "set ylabel " + gnuplot_string("row deposit (summed across the boom)") + "\n";
+    script += "set ylabel " + gnuplot_string("dose per row, mean across the boom (uL/cm^2)") + "\n";
     script += "set lmargin 12\nset rmargin 4\n";
     script += "set xrange " + dose_x_extent(figures, rows).range(0.02, 0.02) + "\n";
     script += "set yrange " + y_extent.range(0.0, 0.25) + "\n";

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/metrics.h"  // AreaSpan
 #include "harness/results_writer.h"
 
 namespace rig::harness {
@@ -31,17 +32,11 @@ struct FlowSample {
 struct DoseSample {
     double along_m = kNotMeasured;
     double first_pass_dose = kNotMeasured;    // sprayed before the breakpoint stop
-    double continuation_dose = kNotMeasured;  // sprayed after the resume; same unit, e.g. ul_cm2
+    double continuation_dose = kNotMeasured;  // sprayed after the resume; same unit (the rig: uL/cm^2, mean across the boom)
 };
 
 // A stretch of track the harness classified; name is "operational", "repeated",
 // "continuation" or "missed" (other names are drawn in grey).
-struct AreaSpan {
-    std::string name;
-    double from_along_m = kNotMeasured;
-    double to_along_m = kNotMeasured;
-};
-
 // Wake-up jitter of one device emulator (real-time runs only).
 struct JitterRow {
     std::string device;

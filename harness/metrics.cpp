@@ -33,7 +33,7 @@ std::map<std::string, double> breakpoint_metrics(const TraceRecorder& trace, con
     return metrics;
 }
 
-std::map<std::string, double> flow_metrics(const std::vector<FlowSample>& samples, const FlowEpisode& episode,
+std::map<std::string, double> flow_metrics(const std::vector<MainFlowSample>& samples, const FlowEpisode& episode,
                                            double target_l_min, double band_pct, double never_settled_after_s) {
     std::map<std::string, double> metrics;
     const double band_l_min = band_pct / 100.0 * target_l_min;
@@ -41,7 +41,7 @@ std::map<std::string, double> flow_metrics(const std::vector<FlowSample>& sample
     bool settled = false;
     TimeNs settled_ns = episode.end_ns;
     bool any = false;
-    for (const FlowSample& sample : samples) {
+    for (const MainFlowSample& sample : samples) {
         if (sample.t_ns < episode.open_command_ns || sample.t_ns > episode.end_ns) continue;
         any = true;
         if (std::abs(sample.main_flow_l_min - target_l_min) > band_l_min) {
@@ -59,7 +59,7 @@ std::map<std::string, double> flow_metrics(const std::vector<FlowSample>& sample
     double error_sum = 0.0;
     double flow_sum = 0.0;
     int count = 0;
-    for (const FlowSample& sample : samples) {
+    for (const MainFlowSample& sample : samples) {
         if (sample.t_ns < error_from_ns || sample.t_ns > episode.end_ns) continue;
         error_sum += std::abs(sample.main_flow_l_min - target_l_min) / target_l_min;
         flow_sum += sample.main_flow_l_min;

@@ -31,7 +31,7 @@ std::map<std::string, double> breakpoint_metrics(const TraceRecorder& trace, con
 
 // ---------------------------------------------------------------- flow control
 
-struct FlowSample {
+struct MainFlowSample {
     TimeNs t_ns = 0;
     double main_flow_l_min = 0.0;  // truth
 };
@@ -50,7 +50,7 @@ struct FlowEpisode {
 // any sane limit) and the error is taken after open + never_settled_after_s.
 //   flow_adjust_time_s, flow_error_pct, flow_mean_l_min (after settling),
 //   flow_settled (1 or 0)
-std::map<std::string, double> flow_metrics(const std::vector<FlowSample>& samples, const FlowEpisode& episode,
+std::map<std::string, double> flow_metrics(const std::vector<MainFlowSample>& samples, const FlowEpisode& episode,
                                            double target_l_min, double band_pct = 3.0,
                                            double never_settled_after_s = 1.7);
 
@@ -73,6 +73,7 @@ struct DepositionJudging {
     double cv_window_m = 6.0;
 };
 
+// A stretch of the track, for the CV areas and the report's shading.
 struct AreaSpan {
     std::string name;  // operational, repeated, continuation, missed
     double from_along_m = 0.0;
