@@ -28,6 +28,9 @@
 #include "rig/child_process.h"
 #include "rig/domain_lease.h"
 #include "rig/lockstep.h"
+#include "rig/pty_pair.h"
+#include "rig/realtime.h"
+#include "rig/wire_adapters.h"
 
 namespace rig::harness {
 
@@ -177,13 +180,92 @@ std::string log_tail(const std::filesystem::path& log, std::size_t max_lines = 6
     return tail;
 }
 
+// SCHED_FIFO priority the harness asks for in real-time runs (the controller asks for 40).
+constexpr int kRealtimePriority = 50;
+
+// The rig's ends of the bench wires a case asks for, and what the controller
+// process must be told to use the far ends.
+struct BenchWires {
+    std::unique_ptr<PtyPair> gnss_pty;
+    std::unique_ptr<SerialPort> gnss_device;
+    SerialPort* gnss_port = nullptr;          // the rig writes NMEA here
+    std::unique_ptr<PtyLink> modbus_link;
+    std::unique_ptr<BoardIoWire> board_io;
+    std::vector<std::string> controller_args;
+    std::string description = "dds";
+};
+
+BenchWires open_bench_wires(const CaseSpec& spec) {
+    BenchWires wires;
+    const WiringSpec& wiring = spec.wiring;
+    std::vector<std::string> parts;
+    if (wiring.gnss == GnssWire::serial) {
+        SerialSettings line;
+        line.baud = wiring.nmea_baud;
+        std::string far_end;
+        if (wiring.gnss_port == "pty") {
+            wires.gnss_pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
+            wires.gnss_port = &wires.gnss_pty->master();
+            far_end = wires.gnss_pty->slave_path();
+        } else {
+            wires.gnss_device = std::make_unique<SerialPort>(wiring.gnss_port, line);
+            wires.gnss_port = wires.gnss_device.get();
+            far_end = wiring.gnss_port;
+        }
+        wires.controller_args.insert(wires.controller_args.end(),
+                                     {"--nmea-serial", far_end, "--nmea-baud", std::to_string(wiring.nmea_baud)});
+        parts.push_back("gnss serial " + far_end + " " + std::to_string(wiring.nmea_baud) + " baud");
+    } else {
+        parts.push_back("gnss dds");
+    }
+    switch (wiring.board_io) {
+        case BoardIoWireKind::dds: parts.push_back("board_io dds"); break;
+        case BoardIoWireKind::modbus_rtu: {
+            modbus::RtuSlaveOptions options;
+            options.line.baud = wiring.modbus_baud;
+            std::string far_end = wiring.modbus_port;
+            if (wiring.modbus_port == "pty") {
+                wires.modbus_link = std::make_unique<PtyLink>();
+                options.line.device = wires.modbus_link->slave_path_a();
+                far_end = wires.modbus_link->slave_path_b();
+            } else {
+                options.line.device = wiring.modbus_port;
+            }
+            wires.board_io = std::make_unique<ModbusSlaveWire>(options);
+            wires.controller_args.insert(wires.controller_args.end(), {"--modbus-rtu", far_end, "--modbus-baud",
+                                                                       std::to_string(wiring.modbus_baud)});
+            parts.push_back("board_io modbus_rtu " + far_end + " " + std::to_string(wiring.modbus_baud) + " baud");
+            break;
+        }
+        case BoardIoWireKind::modbus_tcp: {
+            modbus::TcpSlaveOptions options;
+            const modbus::TcpEndpoint endpoint = modbus::parse_tcp_endpoint(wiring.modbus_tcp);
+            options.bind_address = endpoint.address;
+            options.port = endpoint.port;
+            auto wire = std::make_unique<ModbusSlaveWire>(options);
+            const std::string address = endpoint.address + ":" + std::to_string(wire->slave().tcp_port());
+            wires.controller_args.insert(wires.controller_args.end(), {"--modbus-tcp", address});
+            parts.push_back("board_io modbus_tcp " + address);
+            wires.board_io = std::move(wire);
+            break;
+        }
+        case BoardIoWireKind::hid: {
+            // A real bench board; the controller is wired to it, not to the rig process.
+            auto transport = HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
+            const std::string description = transport->description();
+            wires.board_io = std::make_unique<HidBoardWire>(std::make_unique<HidBoard>(std::move(transport)), description);
+            parts.push_back("board_io hid " + description);
+            break;
+        }
+    }
+    wires.description.clear();
+    for (const std::string& part : parts) wires.description += (wires.description.empty() ? "" : ", ") + part;
+    return wires;
+}
+
 }  // namespace
 
 void validate_for_run(const CaseSpec& spec, const RunOptions& /*options*/) {
-    if (spec.mode == RunMode::realtime) {
-        throw ConfigError(SourceLocation{spec.source_path.string(), 0, 0, "mode"},
-                          "realtime runs of whole cases are not implemented yet (lockstep only)");
-    }
     // The reference controller's own keys are checked before anything starts; a
     // case naming another controller leaves its section to that controller.
     if (spec.controller.command.empty()) {
@@ -342,7 +424,13 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
         const double grid_to_m = spec.breakpoint.along_m + spec.vehicle.overrun_m + 5.0;
         emulators::SprayCircuit circuit(plant, circuit_params(spec, grid_from_m, grid_to_m));
 
-        // The controller under test, in its own process on this run's own domain.
+        // The bench wires (real time only) come first: the controller is given their far ends.
+        BenchWires wires = open_bench_wires(spec);
+        result.mode = std::string(to_string(spec.mode));
+        result.wiring = wires.description;
+
+        // The controller under test, in its own process on this run's own domain
+        // (none when a real board is wired up: `wiring: { controller: external }`).
         const DomainLease lease = DomainLease::acquire();
         write_controller_config(spec, case_dir / "controller.yaml");
         std::vector<std::string> argv = spec.controller.command;
@@ -353,8 +441,16 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
               std::string("--state-dir"), (case_dir / "controller-state").string()}) {
             argv.push_back(arg);
         }
+        if (spec.mode == RunMode::realtime) {
+            argv.insert(argv.end(), {"--clock", "realtime"});
+            argv.insert(argv.end(), wires.controller_args.begin(), wires.controller_args.end());
+        }
         const std::filesystem::path controller_log = case_dir / "controller.log";
-        ChildProcess controller(argv, controller_log);
+        std::optional<ChildProcess> controller;
+        if (!spec.wiring.external_controller) controller.emplace(argv, controller_log);
+        auto stop_controller = [&](std::chrono::milliseconds grace) {
+            return controller ? controller->stop(grace) : std::string("process exited with status 0");
+        };
 
         DdsContext dds(lease.domain_id(), "harness");
         TraceRecorder trace(dds, case_dir / "trace.sqlite");
@@ -375,43 +471,76 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
             plant, emulators::BoomHeightSensorParams{spec.boom_height_sensor.range_m, spec.boom_height_sensor.rate_hz});
         emulators::PanelSwitch button("breakpoint_button", topics::kBreakpointButton, scenario.button);
         emulators::PanelSwitch spray_switch("spray_switch", topics::kSpraySwitch, scenario.spray_switch);
+        // Local nodes step in this order each instant: plant truth and the spray
+        // circuit (which takes the actuator commands) before the devices sample
+        // them, and the wire adapters last (they carry what the devices published).
+        std::vector<Node*> local_nodes{&plant_node, &circuit_node, &gnss,        &encoder,     &flow_meter,
+                                       &pump_sensor, &boom_height, &button,      &spray_switch};
+        std::optional<NmeaSerialAdapter> nmea_adapter;
+        if (wires.gnss_port) local_nodes.push_back(&nmea_adapter.emplace(*wires.gnss_port));
+        std::optional<BoardIoAdapter> board_adapter;
+        if (wires.board_io) local_nodes.push_back(&board_adapter.emplace(*wires.board_io, spec.wiring.board_update_hz));
 
         trace.set_meta("case", spec.name);
         trace.set_meta("case_file", spec.source_path.string());
         trace.set_meta("scenario", std::string(to_string(spec.scenario)));
+        trace.set_meta("mode", result.mode);
         trace.set_meta("seed", std::to_string(result.seed));
-        trace.set_meta("controller_command", controller.command_line());
+        trace.set_meta("controller_command", controller ? controller->command_line() : "external (a wired board)");
+        trace.set_meta("wiring", wires.description);
 
         LockstepTimeouts timeouts;
         timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
-        LockstepMaster master(dds, timeouts);
-        // Local nodes step in this order each instant: plant truth and the spray
-        // circuit (which takes the actuator commands) before the devices sample them.
-        for (Node* node : std::initializer_list<Node*>{&plant_node, &circuit_node, &gnss, &encoder, &flow_meter,
-                                                       &pump_sensor, &boom_height, &button, &spray_switch}) {
-            master.add_local_node(*node);
-        }
-        master.add_remote_node("controller", [&controller] { return controller.exit_description(); });
-        master.set_after_round([&trace](TimeNs t, int round) { trace.drain(t, round); });
-
-        try {
-            master.start();
-            result.startup_wall_seconds = wall.elapsed_s();
-            while (master.advance(end_ns)) {
-                if (wall.elapsed_s() > spec.timeouts.case_wall_s) {
-                    throw NodeFailure("harness", "case exceeded its wall-time bound of " +
-                                                     std::to_string(spec.timeouts.case_wall_s) + " s");
-                }
+        auto liveness = [&controller] { return controller->exit_description(); };
+        auto wall_bound = [&] {
+            if (wall.elapsed_s() > spec.timeouts.case_wall_s) {
+                throw NodeFailure("harness", "case exceeded its wall-time bound of " +
+                                                 std::to_string(spec.timeouts.case_wall_s) + " s");
             }
-            master.shutdown();
-            const std::string ended = controller.stop();
-            if (ended != "process exited with status 0") {
-                throw NodeFailure("controller", "after shutdown: " + ended);
+        };
+        if (spec.mode == RunMode::lockstep) {
+            LockstepMaster master(dds, timeouts);
+            for (Node* node : local_nodes) master.add_local_node(*node);
+            master.add_remote_node("controller", liveness);
+            master.set_after_round([&trace](TimeNs t, int round) { trace.drain(t, round); });
+            try {
+                master.start();
+                result.startup_wall_seconds = wall.elapsed_s();
+                while (master.advance(end_ns)) wall_bound();
+                master.shutdown();
+                const std::string ended = stop_controller(std::chrono::milliseconds(3000));
+                if (ended != "process exited with status 0") throw NodeFailure("controller", "after shutdown: " + ended);
+            } catch (const NodeFailure& failure) {
+                master.shutdown();
+                stop_controller(std::chrono::milliseconds(500));
+                throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
             }
-        } catch (const NodeFailure& failure) {
-            master.shutdown();
-            controller.stop(std::chrono::milliseconds(500));
-            throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
+        } else {
+            result.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
+            RealtimeMaster master(dds, timeouts);
+            for (Node* node : local_nodes) master.add_local_node(*node);
+            if (controller) master.add_remote_node("controller", liveness);
+            if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(wires.board_io.get())) {
+                modbus_wire->set_wake([&dds] { dds.notify_data_arrived(); });
+            }
+            master.set_after_step([&trace](TimeNs t) { trace.drain(t, 0); });
+            try {
+                master.start();
+                result.startup_wall_seconds = wall.elapsed_s();
+                master.run_until(end_ns);
+                master.shutdown();
+                const std::string ended = stop_controller(std::chrono::milliseconds(3000));
+                if (ended != "process exited with status 0") throw NodeFailure("controller", "after shutdown: " + ended);
+            } catch (const std::exception& failure) {
+                master.shutdown();
+                stop_controller(std::chrono::milliseconds(500));
+                throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
+            }
+            for (const auto& [device, stats] : master.emission_jitter()) {
+                result.emission_jitter.push_back(EmissionJitter{device, stats.samples, stats.p50_ms, stats.p99_ms,
+                                                                stats.max_ms});
+                figures.jitter.push_back(JitterRow{device, stats.p50_ms, stats.p99_ms, stats.max_ms});
+            }
         }
         circuit.advance_to(end_ns);
 
@@ -470,21 +599,29 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 
 std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress) {
     std::vector<CaseRun> runs(specs.size());
-    std::atomic<std::size_t> next{0};
     std::mutex progress_mutex;
-    auto worker = [&] {
-        for (std::size_t i = next++; i < specs.size(); i = next++) {
-            runs[i] = run_case(specs[i], options);
-            const CaseResult& result = runs[i].result;
-            std::lock_guard lock(progress_mutex);
-            progress << "rig: [" << (result.passed ? "PASS" : "FAIL") << "] " << result.name << " ("
-                     << result.wall_seconds << " s wall)\n";
-        }
+    auto run_one = [&](std::size_t i) {
+        runs[i] = run_case(specs[i], options);
+        const CaseResult& result = runs[i].result;
+        std::lock_guard lock(progress_mutex);
+        progress << "rig: [" << (result.passed ? "PASS" : "FAIL") << "] " << result.name << " (" << result.wall_seconds
+                 << " s wall)\n";
     };
-    const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(specs.size())));
+    // Lockstep cases share the machine; a real-time case runs alone, after them,
+    // so that other cases' load does not become its scheduling jitter.
+    std::vector<std::size_t> lockstep, realtime;
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+        (specs[i].mode == RunMode::realtime ? realtime : lockstep).push_back(i);
+    }
+    std::atomic<std::size_t> next{0};
+    auto worker = [&] {
+        for (std::size_t k = next++; k < lockstep.size(); k = next++) run_one(lockstep[k]);
+    };
+    const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(lockstep.size())));
     std::vector<std::thread> threads;
     for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
     for (auto& thread : threads) thread.join();
+    for (std::size_t i : realtime) run_one(i);
     return runs;
 }
 

@@ -1,5 +1,7 @@
 #include "harness/case_spec.h"
 
+#include "rig/modbus_protocol.h"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -18,6 +20,20 @@ constexpr EnumChoice<Scenario> kScenarios[] = {
     {"breakpoint_identification", Scenario::breakpoint_identification},
     {"breakpoint_continuation", Scenario::breakpoint_continuation},
     {"static_flow", Scenario::static_flow},
+};
+constexpr EnumChoice<GnssWire> kGnssWires[] = {
+    {"dds", GnssWire::dds},
+    {"serial", GnssWire::serial},
+};
+constexpr EnumChoice<BoardIoWireKind> kBoardIoWires[] = {
+    {"dds", BoardIoWireKind::dds},
+    {"modbus_rtu", BoardIoWireKind::modbus_rtu},
+    {"modbus_tcp", BoardIoWireKind::modbus_tcp},
+    {"hid", BoardIoWireKind::hid},
+};
+constexpr EnumChoice<bool> kControllerPlaces[] = {
+    {"process", false},
+    {"external", true},
 };
 constexpr EnumChoice<GnssTalker> kTalkers[] = {
     {"GP", GnssTalker::gp},
@@ -286,6 +302,27 @@ DepositionSpec read_deposition(const YamlSection& section) {
     return deposition;
 }
 
+WiringSpec read_wiring(const YamlSection& section) {
+    WiringSpec wiring;
+    wiring.gnss = section.optional_enum<GnssWire>("gnss", kGnssWires, wiring.gnss);
+    wiring.board_io = section.optional_enum<BoardIoWireKind>("board_io", kBoardIoWires, wiring.board_io);
+    wiring.gnss_port = section.optional<std::string>("gnss_port", wiring.gnss_port);
+    wiring.nmea_baud = section.optional_in_range<int>("nmea_baud", wiring.nmea_baud, Bounds::closed(1200, 4000000));
+    wiring.modbus_port = section.optional<std::string>("modbus_port", wiring.modbus_port);
+    wiring.modbus_baud = section.optional_in_range<int>("modbus_baud", wiring.modbus_baud, Bounds::closed(1200, 4000000));
+    wiring.modbus_tcp = section.optional<std::string>("modbus_tcp", wiring.modbus_tcp);
+    wiring.hid_vid = static_cast<std::uint16_t>(
+        section.optional_in_range<std::uint32_t>("hid_vid", wiring.hid_vid, Bounds::closed(0, 0xFFFF)));
+    wiring.hid_pid = static_cast<std::uint16_t>(
+        section.optional_in_range<std::uint32_t>("hid_pid", wiring.hid_pid, Bounds::closed(0, 0xFFFF)));
+    wiring.board_update_hz =
+        section.optional_in_range<double>("board_update_hz", wiring.board_update_hz, Bounds::closed(1, 2000));
+    wiring.external_controller = section.optional_enum<bool>("controller", kControllerPlaces, wiring.external_controller);
+    if (wiring.gnss_port.empty()) section.fail("gnss_port", "must be 'pty' or a serial device path");
+    if (wiring.modbus_port.empty()) section.fail("modbus_port", "must be 'pty' or a serial device path");
+    return wiring;
+}
+
 StaticFlowSpec read_static_flow(const YamlSection& section) {
     StaticFlowSpec static_flow;
     static_flow.spray_on_at_s =
@@ -354,6 +391,19 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                                                     ") so the vehicle approaches the breakpoint, got " +
                                                     number_text(spec.vehicle.start_m));
     }
+    if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
+        root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
+    }
+    if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
+        root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
+    }
+    if (spec.wiring.board_io == BoardIoWireKind::modbus_tcp) {
+        try {
+            modbus::parse_tcp_endpoint(spec.wiring.modbus_tcp);
+        } catch (const std::exception& error) {
+            root.section("wiring").fail("modbus_tcp", error.what());
+        }
+    }
     const YamlSection expect = root.section("expect");
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
         const std::string& metric = spec.expect.fail[index];
@@ -375,6 +425,8 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
 
 std::string_view to_string(RunMode mode) { return name_of(kRunModes, mode); }
 std::string_view to_string(Scenario scenario) { return name_of(kScenarios, scenario); }
+std::string_view to_string(GnssWire wire) { return name_of(kGnssWires, wire); }
+std::string_view to_string(BoardIoWireKind wire) { return name_of(kBoardIoWires, wire); }
 
 bool default_limit_applies(Scenario scenario, const std::string& metric) {
     const bool identifies = scenario != Scenario::static_flow;
@@ -460,6 +512,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.boom_height_sensor = read_boom_height_sensor(root.section("boom_height_sensor"));
     spec.deposition = read_deposition(root.section("deposition"));
     spec.static_flow = read_static_flow(root.section("static_flow"));
+    spec.wiring = read_wiring(root.section("wiring"));
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
     spec.expect = read_expect(root.section("expect"));

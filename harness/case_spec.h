@@ -184,6 +184,31 @@ struct StaticFlowSpec {
     double spray_for_s = 8.0;
 };
 
+// Which wire carries what (issue: plug in a real controller). DDS for
+// everything by default; serial, Modbus and HID are bench wires and need
+// `mode: realtime`. Ports are "pty" (the rig makes a pseudo-terminal pair and
+// hands the other end to the controller) or a device path for a real board.
+enum class GnssWire { dds, serial };
+enum class BoardIoWireKind { dds, modbus_rtu, modbus_tcp, hid };
+struct WiringSpec {
+    GnssWire gnss = GnssWire::dds;
+    BoardIoWireKind board_io = BoardIoWireKind::dds;
+    std::string gnss_port = "pty";      // serial: pty or /dev/tty...
+    int nmea_baud = 115200;
+    std::string modbus_port = "pty";    // modbus_rtu: pty or /dev/tty...
+    int modbus_baud = 115200;
+    std::string modbus_tcp = "127.0.0.1:0";  // modbus_tcp: where the rig's slave listens (port 0 = any free)
+    std::uint16_t hid_vid = 0x1209;
+    std::uint16_t hid_pid = 0x0001;
+    double board_update_hz = 200.0;     // how often the board's inputs are refreshed
+    // process: the harness starts the controller command with the wire's ports;
+    // external: a real board is wired up and running; the harness starts nothing.
+    bool external_controller = false;
+    bool uses_bench_wire() const { return gnss != GnssWire::dds || board_io != BoardIoWireKind::dds; }
+};
+std::string_view to_string(GnssWire wire);
+std::string_view to_string(BoardIoWireKind wire);
+
 struct ControllerSpec {
     // argv of the controller executable; empty = the reference controller.
     std::vector<std::string> command;
@@ -231,6 +256,7 @@ struct CaseSpec {
     BoomHeightSensorSpec boom_height_sensor;
     DepositionSpec deposition;
     StaticFlowSpec static_flow;
+    WiringSpec wiring;
     ControllerSpec controller;
     // Limits as written in the file (metric name -> max allowed value); the
     // harness judges against effective_limits(), i.e. these over the defaults.

@@ -14,7 +14,9 @@ std::map<std::string, double> breakpoint_metrics(const TraceRecorder& trace, con
     int reached = 0;
     for (const auto& [t, event] : trace.samples(topics::kBreakpointEvent)) {
         const std::string kind = event.at("kind");
-        if (kind == "stored" && !metrics.count("breakpoint_store_error_m")) {
+        // A board on Modbus or HID reports only that it stored one, not where (null position).
+        if (kind == "stored" && !metrics.count("breakpoint_store_error_m") && event.at("lat_deg").is_number() &&
+            std::isfinite(event.at("lat_deg").get<double>())) {
             const emulators::GeoPoint stored{event.at("lat_deg"), event.at("lon_deg"), 0.0};
             const auto [along_m, cross_m] = plant.field().to_line(stored);
             metrics["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m);

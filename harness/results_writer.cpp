@@ -361,7 +361,7 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
         for (const auto& [name, value] : result.limits) limits[valid_utf8(name)] = value;
         nlohmann::json failures = nlohmann::json::array();
         for (const std::string& failure : result.failures) failures.push_back(valid_utf8(failure));
-        cases.push_back({
+        nlohmann::json one_case = {
             {"name", valid_utf8(result.name)},
             {"file", valid_utf8(result.file)},
             {"passed", case_passed(result)},
@@ -376,7 +376,21 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"sim_seconds", result.sim_seconds},
             {"wall_seconds", result.wall_seconds},
             {"startup_wall_seconds", result.startup_wall_seconds},
-        });
+            {"mode", valid_utf8(result.mode)},
+        };
+        if (result.mode == "realtime") {
+            nlohmann::json jitter = nlohmann::json::object();
+            for (const EmissionJitter& device : result.emission_jitter) {
+                jitter[valid_utf8(device.device)] = {{"samples", device.samples},
+                                                      {"p50_ms", device.p50_ms},
+                                                      {"p99_ms", device.p99_ms},
+                                                      {"max_ms", device.max_ms}};
+            }
+            one_case["realtime"] = {{"scheduling", valid_utf8(result.realtime_scheduling)},
+                                    {"wiring", valid_utf8(result.wiring)},
+                                    {"emission_jitter", std::move(jitter)}};
+        }
+        cases.push_back(std::move(one_case));
     }
     return {
         {"cases", std::move(cases)},

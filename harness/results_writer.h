@@ -12,6 +12,15 @@
 
 namespace rig::harness {
 
+// How late one device's emissions were against their deadlines in a real-time run.
+struct EmissionJitter {
+    std::string device;
+    std::size_t samples = 0;
+    double p50_ms = 0.0;
+    double p99_ms = 0.0;
+    double max_ms = 0.0;
+};
+
 struct CaseResult {
     std::string name;
     std::string file;               // the case file
@@ -27,6 +36,11 @@ struct CaseResult {
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
     double startup_wall_seconds = 0.0;  // of wall_seconds: process start, DDS discovery, hello
+    std::string mode = "lockstep";      // or "realtime"
+    // Real-time runs only: what scheduling the rig got, and the emission jitter per device.
+    std::string realtime_scheduling;
+    std::vector<EmissionJitter> emission_jitter;
+    std::string wiring;                 // e.g. "gnss serial /dev/pts/4, board_io modbus_rtu /dev/pts/6"
 };
 
 struct RunSummary {

@@ -26,6 +26,12 @@ TimeNs RealtimeClock::sleep_until_ns(TimeNs deadline_ns) const {
     return late > 0 ? late : 0;
 }
 
+void RealtimeClock::restart() { start_ = std::chrono::steady_clock::now(); }
+
+std::chrono::steady_clock::time_point RealtimeClock::steady_time(TimeNs t) const {
+    return start_ + std::chrono::nanoseconds(t);
+}
+
 WallStopwatch::WallStopwatch() : start_(std::chrono::steady_clock::now()) {}
 
 double WallStopwatch::elapsed_s() const {

@@ -44,6 +44,10 @@ public:
     // Blocks until now_ns() >= deadline_ns (returns at once if already past).
     // Returns how late the wake-up was, in ns (>= 0).
     TimeNs sleep_until_ns(TimeNs deadline_ns) const;
+    // Time zero is now (a run starts its clock once every node is ready).
+    void restart();
+    // The monotonic instant of `t` on this clock, for waits with a deadline.
+    std::chrono::steady_clock::time_point steady_time(TimeNs t) const;
 
 private:
     std::chrono::steady_clock::time_point start_;

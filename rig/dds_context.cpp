@@ -160,6 +160,16 @@ void DdsContext::notify_data_arrived() {
     arrival_.notify_all();
 }
 
+std::uint64_t DdsContext::arrival_count() {
+    std::lock_guard lock(arrival_mutex_);
+    return arrivals_;
+}
+
+bool DdsContext::wait_for_arrival(std::uint64_t seen, std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock lock(arrival_mutex_);
+    return arrival_.wait_until(lock, deadline, [&] { return arrivals_ != seen; });
+}
+
 std::vector<std::string> DdsContext::wait_received(const std::map<std::string, std::uint64_t>& expected,
                                                    std::chrono::milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;

@@ -163,8 +163,14 @@ public:
     // still short when the timeout passes (empty = all there).
     std::vector<std::string> wait_received(const std::map<std::string, std::uint64_t>& expected,
                                            std::chrono::milliseconds timeout);
-    // Called by readers when data arrives (wakes wait_received).
+    // Called by readers when data arrives (wakes wait_received and
+    // wait_for_arrival); anything else that brings input (a Modbus master's write)
+    // may call it too.
     void notify_data_arrived();
+    // How many arrivals so far; wait_for_arrival returns once it differs from `seen`.
+    std::uint64_t arrival_count();
+    // Blocks until an arrival after `seen` or the deadline; true on an arrival.
+    bool wait_for_arrival(std::uint64_t seen, std::chrono::steady_clock::time_point deadline);
 
     // Waits until every writer's samples are acknowledged by all matched readers.
     // Returns the topics that did not make it in time (empty = all delivered).

@@ -17,10 +17,14 @@ namespace rig::io {
 struct DeviceSignals {
     std::uint32_t wheel_encoder_count = 0;   // land-wheel encoder, cumulative pulses (wraps at 2^32)
     std::uint32_t main_flow_pulses = 0;      // KF11-P10 main-pipeline meter, cumulative pulses (90 /L)
+    // The frequency input's capture timer (1 MHz, wraps) at the meter's last pulse
+    // edge: Eq. 3's t2 measured edge to edge (controller/flow_rate_meter.h).
+    std::uint32_t main_flow_last_edge_us = 0;
     std::uint16_t pump_flow_adc = 0;         // pump-outlet sensor, 4-20 mA -> 0-3.3 V -> 12-bit ADC (Eq. 8)
     std::uint16_t boom_height_adc = 0;       // pull-wire boom-height sensor -> 12-bit ADC
     bool breakpoint_button = false;          // breakpoint button on the board, pressed = true
     bool spray_switch = false;               // operator's main spray switch, on = true
+    bool operator==(const DeviceSignals&) const = default;
 };
 
 // Board outputs: the controller drives these; the rig senses them.
@@ -29,6 +33,7 @@ struct ActuatorCommands {
     bool ball_valve_reverse = false;         // relay 2: towards closed (both on = fault, motor braked)
     bool unloading_valve_open = false;       // pump flow back to the tank
     std::uint8_t section_valves_open = 0;    // bit i = section i switch valve open (up to 8 sections)
+    bool operator==(const ActuatorCommands&) const = default;
 };
 
 // Board status outputs the rig records so it can judge a wired controller the
@@ -38,10 +43,20 @@ struct ControllerIndicators {
     std::uint16_t breakpoints_reached = 0;   // counts up each time the nozzle line is declared at one
     bool breakpoint_pending = false;         // a stored breakpoint lies ahead
     bool odometer_active = false;            // fusion: inside the threshold, odometer integrating
+    bool operator==(const ControllerIndicators&) const = default;
 };
 
 // 12-bit ADC full scale of the STM32F407's converters, and its reference voltage.
 inline constexpr std::uint16_t kAdcFullScale = 4095;
 inline constexpr double kAdcReferenceV = 3.3;
+
+inline std::uint16_t adc_counts_from_voltage(double voltage_v) {
+    const double counts = voltage_v / kAdcReferenceV * kAdcFullScale + 0.5;
+    if (!(counts > 0.0)) return 0;
+    return counts >= kAdcFullScale ? kAdcFullScale : static_cast<std::uint16_t>(counts);
+}
+inline double voltage_from_adc_counts(std::uint16_t counts) {
+    return static_cast<double>(counts) / kAdcFullScale * kAdcReferenceV;
+}
 
 }  // namespace rig::io

@@ -140,6 +140,14 @@ LockstepMaster::TopicCounts LockstepMaster::all_published_counts() const {
     return totals;
 }
 
+void LockstepMaster::check_remotes_alive(TimeNs t) const {
+    for (const Remote& remote : remotes_) {
+        if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) {
+            throw NodeFailure(remote.name, *gone + " (at t=" + format_time(t) + ")");
+        }
+    }
+}
+
 void LockstepMaster::wait_local_readers(TimeNs t) {
     // In slices, so a remote that died is reported as such rather than as slow.
     const TopicCounts expected = all_published_counts();
@@ -273,57 +281,92 @@ void LockstepMaster::shutdown() noexcept {
     }
 }
 
-int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options) {
-    std::unique_ptr<Reader<msg::ClockTick>> tick_reader;
-    std::unique_ptr<Writer<msg::ClockAck>> ack_writer;
-    try {
-        tick_reader = std::make_unique<Reader<msg::ClockTick>>(dds, topics::kClockTick);
-        ack_writer = std::make_unique<Writer<msg::ClockAck>>(dds, topics::kClockAck, false);
-        node.configure(dds);
-    } catch (const std::exception& error) {
-        std::cerr << options.node_name << ": configure failed: " << error.what() << "\n";
-        return 2;
-    }
+FollowerLink::FollowerLink(DdsContext& dds, const FollowerOptions& options)
+    : dds_(dds),
+      options_(options),
+      tick_reader_(std::make_unique<Reader<msg::ClockTick>>(dds, topics::kClockTick)),
+      ack_writer_(std::make_unique<Writer<msg::ClockAck>>(dds, topics::kClockAck, false)) {}
 
-    auto send_ack = [&](std::uint64_t seq, TimeNs next_wake, std::uint32_t published, const std::string& topics,
-                        const std::string& fatal) {
-        msg::ClockAck ack;
-        ack.node_name(options.node_name);
-        ack.seq(seq);
-        ack.next_wake_ns(next_wake);
-        ack.published_count(published);
-        fill_counts(dds.written_counts(), ack.published_counts());
-        ack.subscribed_topics(topics);
-        ack.fatal_error(fatal.substr(0, 1000));
-        ack_writer->publish(ack);
-    };
-
+bool FollowerLink::wait_matched() {
     // Every endpoint must be matched before we say hello; a node reading a topic no
     // one writes is a configuration error the master reports with our name.
     const WallStopwatch startup;
     for (;;) {
         std::vector<std::string> unmatched;
-        for (ReaderBase* reader : dds.readers()) {
+        for (ReaderBase* reader : dds_.readers()) {
             if (reader->matched_writers() < 1) unmatched.push_back("reads " + reader->topic_name());
         }
-        for (WriterBase* writer : dds.writers()) {
+        for (WriterBase* writer : dds_.writers()) {
             if (writer->matched_readers() < 1) unmatched.push_back("writes " + writer->topic_name());
         }
-        if (unmatched.empty()) break;
-        if (startup.elapsed() > options.startup_timeout) {
+        if (unmatched.empty()) return true;
+        if (startup.elapsed() > options_.startup_timeout) {
             std::string list;
             for (const auto& item : unmatched) list += (list.empty() ? "" : "; ") + item;
-            std::cerr << options.node_name << ": no DDS counterpart within " << options.startup_timeout.count()
+            std::cerr << options_.node_name << ": no DDS counterpart within " << options_.startup_timeout.count()
                       << " ms for: " << list << "\n";
-            return 3;
+            return false;
         }
-        tick_reader->wait_for_data(std::chrono::milliseconds(5));
+        tick_reader_->wait_for_data(std::chrono::milliseconds(5));
     }
+}
+
+void FollowerLink::ack(std::uint64_t seq, TimeNs next_wake, std::uint32_t published, const std::string& subscribed,
+                       const std::string& fatal) {
+    msg::ClockAck ack;
+    ack.node_name(options_.node_name);
+    ack.seq(seq);
+    ack.next_wake_ns(next_wake);
+    ack.published_count(published);
+    fill_counts(dds_.written_counts(), ack.published_counts());
+    ack.subscribed_topics(subscribed);
+    ack.fatal_error(fatal.substr(0, 1000));
+    ack_writer_->publish(ack);
+}
+
+void FollowerLink::final_ack(std::uint64_t seq, const std::string& fatal) {
+    ack(seq, kNever, 0, "", fatal);
+    ack_writer_->wait_delivered(options_.delivery_timeout);
+}
+
+std::optional<msg::ClockTick> FollowerLink::next_tick(std::chrono::milliseconds timeout) {
+    if (pending_.empty()) {
+        if (!tick_reader_->wait_for_data(timeout)) return std::nullopt;
+        for (msg::ClockTick& tick : tick_reader_->take_all()) pending_.push_back(std::move(tick));
+    }
+    while (!pending_.empty()) {
+        msg::ClockTick tick = std::move(pending_.front());
+        pending_.pop_front();
+        if (tick.seq() != 0) return tick;
+        // Hello: say which topics we read, so the master waits for its writers to reach them.
+        std::string subscribed;
+        for (ReaderBase* reader : dds_.readers()) {
+            if (reader == tick_reader_.get()) continue;
+            subscribed += (subscribed.empty() ? "" : ",") + reader->topic_name();
+        }
+        ack(0, 0, 0, subscribed, "");
+    }
+    return std::nullopt;
+}
+
+bool FollowerLink::harness_present() const { return tick_reader_->matched_writers() > 0; }
+
+int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options) {
+    std::unique_ptr<FollowerLink> link;
+    try {
+        link = std::make_unique<FollowerLink>(dds, options);
+        node.configure(dds);
+    } catch (const std::exception& error) {
+        std::cerr << options.node_name << ": configure failed: " << error.what() << "\n";
+        return 2;
+    }
+    if (!link->wait_matched()) return 3;
 
     bool activated = false;
     WallStopwatch idle;
     for (;;) {
-        if (!tick_reader->wait_for_data(kPollSlice)) {
+        const std::optional<msg::ClockTick> tick = link->next_tick(kPollSlice);
+        if (!tick) {
             if (idle.elapsed() > options.idle_timeout) {
                 std::cerr << options.node_name << ": no tick from the harness for " << options.idle_timeout.count()
                           << " ms; exiting\n";
@@ -332,52 +375,37 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
             continue;
         }
         idle = WallStopwatch();
-        for (const msg::ClockTick& tick : tick_reader->take_all()) {
-            if (tick.seq() == 0) {
-                std::string topics;
-                for (ReaderBase* reader : dds.readers()) {
-                    if (reader == tick_reader.get()) continue;
-                    topics += (topics.empty() ? "" : ",") + reader->topic_name();
-                }
-                send_ack(0, 0, 0, topics, "");
-                continue;
-            }
-            if (tick.shutdown()) {
-                node.shutdown();
-                send_ack(tick.seq(), kNever, 0, "", "");
-                ack_writer->wait_delivered(options.delivery_timeout);
-                return 0;
-            }
-            clock.set_ns(tick.time_ns());
-            // Counted delivery: everything published so far must be in our readers
-            // before we take our inputs (a sample published at t is seen at t).
-            if (const auto short_topics = dds.wait_received(read_counts(tick.published_counts()),
-                                                           options.delivery_timeout);
-                !short_topics.empty()) {
-                const std::string problem = "samples on " + join(short_topics) + " published by t=" +
-                                            format_time(tick.time_ns()) + " did not arrive within " +
-                                            std::to_string(options.delivery_timeout.count()) + " ms";
-                send_ack(tick.seq(), kNever, 0, "", problem);
-                ack_writer->wait_delivered(options.delivery_timeout);
-                std::cerr << options.node_name << ": " << problem << "\n";
-                return 5;
-            }
-            dds.take_published_count();
-            TimeNs next_wake = kNever;
-            try {
-                if (!activated) {
-                    node.activate(tick.time_ns());
-                    activated = true;
-                }
-                next_wake = node.step(tick.time_ns());
-            } catch (const std::exception& error) {
-                send_ack(tick.seq(), kNever, 0, "", error.what());
-                ack_writer->wait_delivered(options.delivery_timeout);
-                std::cerr << options.node_name << ": " << error.what() << "\n";
-                return 2;
-            }
-            send_ack(tick.seq(), next_wake, dds.take_published_count(), "", "");
+        if (tick->shutdown()) {
+            node.shutdown();
+            link->final_ack(tick->seq(), "");
+            return 0;
         }
+        clock.set_ns(tick->time_ns());
+        // Counted delivery: everything published so far must be in our readers
+        // before we take our inputs (a sample published at t is seen at t).
+        if (const auto short_topics = dds.wait_received(read_counts(tick->published_counts()), options.delivery_timeout);
+            !short_topics.empty()) {
+            const std::string problem = "samples on " + join(short_topics) + " published by t=" +
+                                        format_time(tick->time_ns()) + " did not arrive within " +
+                                        std::to_string(options.delivery_timeout.count()) + " ms";
+            link->final_ack(tick->seq(), problem);
+            std::cerr << options.node_name << ": " << problem << "\n";
+            return 5;
+        }
+        dds.take_published_count();
+        TimeNs next_wake = kNever;
+        try {
+            if (!activated) {
+                node.activate(tick->time_ns());
+                activated = true;
+            }
+            next_wake = node.step(tick->time_ns());
+        } catch (const std::exception& error) {
+            link->final_ack(tick->seq(), error.what());
+            std::cerr << options.node_name << ": " << error.what() << "\n";
+            return 2;
+        }
+        link->ack(tick->seq(), next_wake, dds.take_published_count(), "", "");
     }
 }
 

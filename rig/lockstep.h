@@ -24,6 +24,7 @@
 // its own writers to reach them. A remote that does not answer within the
 // wall-time bound, or whose process ends, fails the run with its name.
 #include <chrono>
+#include <deque>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -80,6 +81,11 @@ public:
     void shutdown() noexcept;
 
     std::uint64_t ticks_sent() const { return seq_; }
+    // Real-time runs (rig/realtime.h) use the master for the remotes only: one
+    // tick at t tells them to start their clocks, and liveness is checked here.
+    void tick_remotes_at(TimeNs t) { tick_remotes(t, false); }
+    // Throws NodeFailure naming a remote whose process is gone.
+    void check_remotes_alive(TimeNs t) const;
     TimeNs now_ns() const { return now_ns_; }
 
 private:
@@ -121,6 +127,32 @@ struct FollowerOptions {
     std::chrono::milliseconds idle_timeout{120'000};
     std::chrono::milliseconds startup_timeout{30'000};
     std::chrono::milliseconds delivery_timeout{10'000};
+};
+
+// The node side of the clock protocol, shared by the lockstep follower and the
+// real-time one (rig/realtime.h): the tick reader, the ack writer, the hello.
+class FollowerLink {
+public:
+    FollowerLink(DdsContext& dds, const FollowerOptions& options);
+    // Waits until every endpoint in the context has a counterpart; false (and says
+    // which ones on stderr) when the startup timeout passes.
+    bool wait_matched();
+    // The next tick other than a hello (hellos are answered here, with the topics
+    // this process reads); nullopt when none came within `timeout`.
+    std::optional<msg::ClockTick> next_tick(std::chrono::milliseconds timeout);
+    void ack(std::uint64_t seq, TimeNs next_wake, std::uint32_t published, const std::string& subscribed,
+             const std::string& fatal);
+    // An ack after which the process ends: waits until it is delivered.
+    void final_ack(std::uint64_t seq, const std::string& fatal);
+    // The harness's clock writer is still matched (it goes away when the harness dies).
+    bool harness_present() const;
+
+private:
+    DdsContext& dds_;
+    FollowerOptions options_;
+    std::unique_ptr<Reader<msg::ClockTick>> tick_reader_;
+    std::unique_ptr<Writer<msg::ClockAck>> ack_writer_;
+    std::deque<msg::ClockTick> pending_;
 };
 
 // Follower side: runs `node` in this process under the master's ticks until the

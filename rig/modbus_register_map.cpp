@@ -41,6 +41,8 @@ InputRegisters encode_input_registers(const io::DeviceSignals& signals) {
     registers[kInputPumpFlowAdc] = checked_adc(signals.pump_flow_adc, "pump_flow_adc");
     registers[kInputBoomHeightAdc] = checked_adc(signals.boom_height_adc, "boom_height_adc");
     registers[kInputMapVersion] = kRegisterMapVersion;
+    registers[kInputMainFlowLastEdgeHigh] = high_word(signals.main_flow_last_edge_us);
+    registers[kInputMainFlowLastEdgeLow] = low_word(signals.main_flow_last_edge_us);
     return registers;
 }
 
@@ -64,6 +66,8 @@ io::DeviceSignals decode_device_signals(const InputRegisters& input_registers, c
         join_words(input_registers[kInputWheelEncoderCountHigh], input_registers[kInputWheelEncoderCountLow]);
     signals.main_flow_pulses =
         join_words(input_registers[kInputMainFlowPulsesHigh], input_registers[kInputMainFlowPulsesLow]);
+    signals.main_flow_last_edge_us =
+        join_words(input_registers[kInputMainFlowLastEdgeHigh], input_registers[kInputMainFlowLastEdgeLow]);
     signals.pump_flow_adc = input_registers[kInputPumpFlowAdc];
     signals.boom_height_adc = input_registers[kInputBoomHeightAdc];
     signals.breakpoint_button = discrete_inputs[kDiscreteBreakpointButton];
@@ -135,6 +139,8 @@ std::string input_register_name(std::uint16_t address) {
         case kInputWheelEncoderCountLow: return "wheel_encoder_count (low word)";
         case kInputMainFlowPulsesHigh: return "main_flow_pulses (high word)";
         case kInputMainFlowPulsesLow: return "main_flow_pulses (low word)";
+        case kInputMainFlowLastEdgeHigh: return "main_flow_last_edge_us (high word)";
+        case kInputMainFlowLastEdgeLow: return "main_flow_last_edge_us (low word)";
         case kInputPumpFlowAdc: return "pump_flow_adc";
         case kInputBoomHeightAdc: return "boom_height_adc";
         case kInputMapVersion: return "map_version";

@@ -61,10 +61,11 @@ public:
 };
 
 void check_reads(const MbpollPeer& peer) {
-    const mt::CommandResult registers = peer.mbpoll("-t 3 -r 0 -c 7");
+    const mt::CommandResult registers = peer.mbpoll("-t 3 -r 0 -c 9");
     ASSERT_EQ(registers.exit_code, 0) << registers.output;
     const std::map<int, long long> expected{{0, 0x1234}, {1, 0x5678}, {2, 0x0001}, {3, 0xE240},
-                                            {4, 2048},   {5, 310},    {6, kRegisterMapVersion}};
+                                            {4, 2048},   {5, 310},    {6, kRegisterMapVersion},
+                                            {7, 0},      {8, 0}};
     EXPECT_EQ(printed_values(registers.output), expected) << registers.output;
 
     const mt::CommandResult counters = peer.mbpoll("-t 3:int -B -r 0 -c 2");
@@ -119,7 +120,7 @@ void check_exceptions(const MbpollPeer& peer, const ModbusSlave& slave) {
     const mt::CommandResult reserved = peer.mbpoll("-t 0 -r 4", "1");
     EXPECT_NE(reserved.exit_code, 0);
     EXPECT_NE(reserved.output.find("Illegal data value"), std::string::npos) << reserved.output;
-    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 7 -c 1");
+    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 9 -c 1");
     EXPECT_NE(outside.exit_code, 0);
     EXPECT_NE(outside.output.find("Illegal data address"), std::string::npos) << outside.output;
     const auto after = slave.statistics();

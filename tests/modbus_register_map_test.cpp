@@ -45,7 +45,7 @@ TEST(ModbusRegisterMap, WordOrderIsHighWordFirst) {
     EXPECT_EQ(registers[4], 4095);
     EXPECT_EQ(registers[5], 17);
     EXPECT_EQ(registers[6], kRegisterMapVersion);
-    EXPECT_EQ(map_version_of(registers), 1);
+    EXPECT_EQ(map_version_of(registers), 2);
 }
 
 TEST(ModbusRegisterMap, DeviceSignalsRoundTrip) {
@@ -186,7 +186,8 @@ TEST(ModbusRegisterMap, ReservedFlagBitsAreRefusedOnWriteAndIgnoredOnDecode) {
 TEST(ModbusRegisterMap, NamesForMessages) {
     EXPECT_EQ(input_register_name(0), "wheel_encoder_count (high word)");
     EXPECT_EQ(input_register_name(6), "map_version");
-    EXPECT_EQ(input_register_name(7), "unmapped");
+    EXPECT_EQ(input_register_name(7), "main_flow_last_edge_us (high word)");
+    EXPECT_EQ(input_register_name(9), "unmapped");
     EXPECT_EQ(holding_register_name(2), "indicator_flags");
     EXPECT_EQ(holding_register_name(3), "unmapped");
 }

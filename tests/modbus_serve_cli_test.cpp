@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "harness/bench_modbus.h"
+#include "rig/modbus_register_map.h"
 #include "modbus_test_support.h"
 #include "rig/child_process.h"
 #include "rig/modbus_master.h"
@@ -112,7 +113,7 @@ TEST(ModbusServeCommand, ServesTcpPrintsEveryChangeAndStopsOnSigint) {
     ServeProcess serve("serve-tcp", {"--tcp", "127.0.0.1:0", "--speed-km-h", "6", "--wheel-diameter-m", "1.0",
                                      "--pulses-per-rev", "1000", "--flow-l-min", "20", "--pulses-per-l", "90",
                                      "--pump-flow-adc", "1000", "--spray-switch"});
-    ASSERT_TRUE(serve.wait_for("serving register map v1 on tcp 127.0.0.1:")) << serve.log();
+    ASSERT_TRUE(serve.wait_for("serving register map v" + std::to_string(rig::modbus::kRegisterMapVersion) + " on tcp 127.0.0.1:")) << serve.log();
     const std::string log = serve.log();
     const std::string marker = "on tcp 127.0.0.1:";
     const auto port_at = log.find(marker);
@@ -169,7 +170,7 @@ TEST(ModbusServeCommand, ServesRtuWithTheGivenLineSettings) {
     mt::PtyPair pair("serve-rtu");
     ServeProcess serve("serve-rtu-log", {"--rtu", pair.slave_end(), "--baud", "57600", "--parity", "E",
                                          "--slave-id", "7", "--breakpoint-button", "--boom-height-adc", "4095"});
-    ASSERT_TRUE(serve.wait_for("serving register map v1 on rtu " + pair.slave_end() + " 57600 8E1 slave 7"))
+    ASSERT_TRUE(serve.wait_for("serving register map v" + std::to_string(rig::modbus::kRegisterMapVersion) + " on rtu " + pair.slave_end() + " 57600 8E1 slave 7"))
         << serve.log();
     modbus::RtuMasterOptions options;
     options.line.device = pair.master_end();

@@ -1,0 +1,126 @@
+#include "controller/wired_board_controller.h"
+
+#include <iostream>
+
+namespace rig::controller {
+
+WiredBoardController::WiredBoardController(std::string node_name, ControllerConfig config,
+                                           const std::filesystem::path& state_dir, WiredBoardOptions options)
+    : name_(std::move(node_name)),
+      options_(std::move(options)),
+      firmware_(std::move(config), state_dir),
+      poll_period_ns_(std::chrono::duration_cast<std::chrono::nanoseconds>(options_.poll_period).count()) {}
+
+void WiredBoardController::configure(DdsContext& /*dds*/) {
+    if (options_.nmea_port.empty()) throw std::runtime_error("wired mode needs the NMEA serial port");
+    nmea_port_ = std::make_unique<SerialPort>(options_.nmea_port, options_.nmea_line);
+    if (options_.modbus_rtu) {
+        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_rtu);
+    } else if (options_.modbus_tcp) {
+        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_tcp);
+    } else {
+        throw std::runtime_error("wired mode needs a Modbus RTU line or a Modbus TCP slave for the board's I/O");
+    }
+}
+
+void WiredBoardController::activate(TimeNs now_ns) {
+    firmware_.start(now_ns);
+    next_poll_ns_ = now_ns;
+}
+
+template <class Call>
+auto WiredBoardController::with_retries(Call call) {
+    for (int attempt = 0;; ++attempt) {
+        try {
+            return call();
+        } catch (const modbus::ModbusMasterError& error) {
+            // A frame lost on the line is retried; a slave that refuses (an exception
+            // response, the wrong map) is not going to change its mind.
+            const bool transient = error.kind() == modbus::ModbusMasterError::Kind::timeout ||
+                                   error.kind() == modbus::ModbusMasterError::Kind::bad_response;
+            if (!transient || attempt >= options_.modbus_retries) throw;
+            ++retries_used_;
+        }
+    }
+}
+
+void WiredBoardController::read_nmea(TimeNs now_ns) {
+    // Whatever the UART holds now; complete lines go to the parser.
+    for (;;) {
+        const std::string chunk = nmea_port_->read_some(std::chrono::milliseconds(0));
+        if (chunk.empty()) break;
+        nmea_buffer_ += chunk;
+    }
+    std::size_t line_end;
+    while ((line_end = nmea_buffer_.find('\n')) != std::string::npos) {
+        firmware_.on_nmea_sentence(nmea_buffer_.substr(0, line_end + 1), now_ns);
+        nmea_buffer_.erase(0, line_end + 1);
+    }
+    // A line longer than any NMEA sentence is noise on the wire: drop it (the
+    // parser would reject it anyway) rather than grow without bound.
+    if (nmea_buffer_.size() > 4096) {
+        firmware_.on_nmea_sentence(nmea_buffer_, now_ns);
+        nmea_buffer_.clear();
+    }
+}
+
+void WiredBoardController::poll_board(TimeNs now_ns) {
+    const io::DeviceSignals inputs = with_retries([&] { return board_->read_device_signals(); });
+    firmware_.on_encoder_count(inputs.wheel_encoder_count, now_ns);
+    firmware_.on_flow_meter_count(inputs.main_flow_pulses, inputs.main_flow_last_edge_us, now_ns);
+    firmware_.on_pump_sensor_voltage(io::voltage_from_adc_counts(inputs.pump_flow_adc), now_ns);
+    firmware_.on_boom_height_voltage(io::voltage_from_adc_counts(inputs.boom_height_adc), now_ns);
+    if (!last_inputs_ || inputs.breakpoint_button != last_inputs_->breakpoint_button) {
+        firmware_.on_breakpoint_button(inputs.breakpoint_button, now_ns);
+    }
+    if (!last_inputs_ || inputs.spray_switch != last_inputs_->spray_switch) {
+        firmware_.on_spray_switch(inputs.spray_switch, now_ns);
+    }
+    last_inputs_ = inputs;
+}
+
+void WiredBoardController::write_outputs() {
+    const io::ActuatorCommands& actuators = firmware_.actuators();
+    if (!written_actuators_ || !(*written_actuators_ == actuators)) {
+        with_retries([&] {
+            board_->write_actuator_commands(actuators);
+            return 0;
+        });
+        written_actuators_ = actuators;
+    }
+    const io::ControllerIndicators indicators = firmware_.indicators();
+    if (!written_indicators_ || !(*written_indicators_ == indicators)) {
+        with_retries([&] {
+            board_->write_indicators(indicators);
+            return 0;
+        });
+        written_indicators_ = indicators;
+    }
+}
+
+TimeNs WiredBoardController::step(TimeNs now_ns) {
+    read_nmea(now_ns);
+    if (now_ns >= next_poll_ns_) {
+        poll_board(now_ns);
+        next_poll_ns_ = next_period_boundary(now_ns, poll_period_ns_);
+    }
+    const TimeNs firmware_wake = firmware_.update(now_ns);
+    write_outputs();
+    for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
+    firmware_.take_events();  // on this wire the events reach the rig as the indicator counters
+    return std::min(firmware_wake, next_poll_ns_);
+}
+
+void WiredBoardController::shutdown() {
+    // Leave the plant safe: relays off, sections closed, pump unloaded.
+    if (!board_) return;
+    try {
+        io::ActuatorCommands safe;
+        safe.unloading_valve_open = true;
+        board_->write_actuator_commands(safe);
+    } catch (const std::exception& error) {
+        std::cerr << name_ << ": could not leave the outputs safe at shutdown: " << error.what() << "\n";
+    }
+}
+
+}  // namespace rig::controller

@@ -1,0 +1,181 @@
+#include "rig/wire_adapters.h"
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+#include "idl/topics.h"
+
+namespace rig {
+
+namespace {
+
+constexpr std::chrono::milliseconds kSerialWriteTimeout{1000};
+
+}  // namespace
+
+// ------------------------------------------------------------------ NMEA on a serial port
+
+NmeaSerialAdapter::NmeaSerialAdapter(SerialPort& port) : port_(port) {}
+
+void NmeaSerialAdapter::configure(DdsContext& dds) {
+    nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
+}
+
+bool NmeaSerialAdapter::has_unread_input() const { return nmea_reader_->has_unread(); }
+
+TimeNs NmeaSerialAdapter::step(TimeNs /*now_ns*/) {
+    for (const msg::NmeaSentence& sentence : nmea_reader_->take_all()) {
+        port_.write_all(sentence.sentence().to_string(), kSerialWriteTimeout);
+        ++sentences_written_;
+    }
+    return kNever;
+}
+
+// ------------------------------------------------------------------ Modbus slave wire
+
+modbus::ModbusSlaveCallbacks ModbusSlaveWire::callbacks() {
+    modbus::ModbusSlaveCallbacks callbacks;
+    callbacks.on_master_write = [signal = signal_](const modbus::MasterWrite&) {
+        std::lock_guard lock(signal->mutex);
+        if (signal->wake) signal->wake();
+    };
+    callbacks.on_problem = [](const std::string& problem) { std::cerr << "rig: modbus: " << problem << "\n"; };
+    return callbacks;
+}
+
+ModbusSlaveWire::ModbusSlaveWire(const modbus::TcpSlaveOptions& options)
+    : slave_(std::make_unique<modbus::ModbusSlave>(options, callbacks())) {}
+
+ModbusSlaveWire::ModbusSlaveWire(const modbus::RtuSlaveOptions& options)
+    : slave_(std::make_unique<modbus::ModbusSlave>(options, callbacks())) {}
+
+void ModbusSlaveWire::set_wake(std::function<void()> wake) {
+    std::lock_guard lock(signal_->mutex);
+    signal_->wake = std::move(wake);
+}
+
+std::string ModbusSlaveWire::description() const { return "Modbus slave " + slave_->endpoint(); }
+
+void ModbusSlaveWire::put_inputs(const io::DeviceSignals& signals, TimeNs /*spread_ns*/) {
+    slave_->set_device_signals(signals);
+    if (const auto failure = slave_->server_failure()) {
+        throw std::runtime_error("Modbus slave " + slave_->endpoint() + " stopped: " + *failure);
+    }
+}
+
+io::ActuatorCommands ModbusSlaveWire::outputs() { return slave_->actuator_commands(); }
+
+io::ControllerIndicators ModbusSlaveWire::indicators() { return slave_->indicators(); }
+
+bool ModbusSlaveWire::changed() {
+    const std::uint64_t writes = slave_->master_write_count();
+    const bool changed = writes != writes_seen_;
+    writes_seen_ = writes;
+    return changed;
+}
+
+// ------------------------------------------------------------------ HID board wire
+
+HidBoardWire::HidBoardWire(std::unique_ptr<HidBoard> board, std::string description)
+    : board_(std::move(board)), description_(std::move(description)) {}
+
+void HidBoardWire::put_inputs(const io::DeviceSignals& signals, TimeNs spread_ns) {
+    board_->apply(signals, spread_ns);
+    latest_ = board_->read_actuators();
+}
+
+io::ActuatorCommands HidBoardWire::outputs() { return latest_; }
+
+io::ControllerIndicators HidBoardWire::indicators() { return board_->indicators(); }
+
+// ------------------------------------------------------------------ board I/O adapter
+
+BoardIoAdapter::BoardIoAdapter(BoardIoWire& wire, double update_rate_hz)
+    : wire_(wire), period_ns_(seconds_to_ns(1.0 / update_rate_hz)) {}
+
+void BoardIoAdapter::configure(DdsContext& dds) {
+    encoder_reader_ = std::make_unique<Reader<msg::EncoderCount>>(dds, topics::kWheelEncoder);
+    flow_meter_reader_ = std::make_unique<Reader<msg::FlowMeterCount>>(dds, topics::kMainFlowMeter);
+    pump_sensor_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kPumpFlowSensor);
+    boom_height_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kBoomHeightSensor);
+    button_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kBreakpointButton);
+    spray_switch_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kSpraySwitch);
+    relays_writer_ = std::make_unique<Writer<msg::BallValveRelays>>(dds, topics::kBallValveRelays);
+    sections_writer_ = std::make_unique<Writer<msg::SectionValves>>(dds, topics::kSectionValves);
+    unloading_writer_ = std::make_unique<Writer<msg::UnloadingValve>>(dds, topics::kUnloadingValve);
+    event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
+}
+
+bool BoardIoAdapter::has_unread_input() const {
+    // Device topics are taken at the update rate; the board's own writes come in at once.
+    return wire_.changed();
+}
+
+void BoardIoAdapter::take_device_topics() {
+    for (const auto& sample : encoder_reader_->take_all()) signals_.wheel_encoder_count = sample.count_pulses();
+    for (const auto& sample : flow_meter_reader_->take_all()) {
+        signals_.main_flow_pulses = sample.count_pulses();
+        signals_.main_flow_last_edge_us = sample.last_edge_capture_us();
+    }
+    for (const auto& sample : pump_sensor_reader_->take_all()) {
+        signals_.pump_flow_adc = io::adc_counts_from_voltage(sample.voltage_v());
+    }
+    for (const auto& sample : boom_height_reader_->take_all()) {
+        signals_.boom_height_adc = io::adc_counts_from_voltage(sample.voltage_v());
+    }
+    for (const auto& sample : button_reader_->take_all()) signals_.breakpoint_button = sample.closed();
+    for (const auto& sample : spray_switch_reader_->take_all()) signals_.spray_switch = sample.closed();
+}
+
+void BoardIoAdapter::publish_outputs(TimeNs now_ns) {
+    const io::ActuatorCommands outputs = wire_.outputs();
+    const bool first = !published_;
+    if (first || outputs.ball_valve_forward != published_->ball_valve_forward ||
+        outputs.ball_valve_reverse != published_->ball_valve_reverse) {
+        msg::BallValveRelays relays;
+        relays.forward(outputs.ball_valve_forward);
+        relays.reverse(outputs.ball_valve_reverse);
+        relays_writer_->publish(relays);
+    }
+    if (first || outputs.section_valves_open != published_->section_valves_open) {
+        msg::SectionValves sections;
+        sections.open_mask(outputs.section_valves_open);
+        sections_writer_->publish(sections);
+    }
+    if (first || outputs.unloading_valve_open != published_->unloading_valve_open) {
+        msg::UnloadingValve unloading;
+        unloading.open(outputs.unloading_valve_open);
+        unloading_writer_->publish(unloading);
+    }
+    published_ = outputs;
+
+    // The board's breakpoint counters become events (its claims; position unknown on this wire).
+    const io::ControllerIndicators indicators = wire_.indicators();
+    auto emit = [&](std::uint16_t now_count, std::uint16_t& seen, msg::BreakpointEventKind kind) {
+        while (seen != now_count) {
+            ++seen;
+            msg::BreakpointEvent event;
+            event.time_ns(now_ns);
+            event.breakpoint_id(seen);
+            event.kind(kind);
+            event.lat_deg(std::numeric_limits<double>::quiet_NaN());
+            event.lon_deg(std::numeric_limits<double>::quiet_NaN());
+            event_writer_->publish(event);
+        }
+    };
+    emit(indicators.breakpoints_stored, seen_indicators_.breakpoints_stored, msg::BREAKPOINT_STORED);
+    emit(indicators.breakpoints_reached, seen_indicators_.breakpoints_reached, msg::BREAKPOINT_REACHED);
+}
+
+TimeNs BoardIoAdapter::step(TimeNs now_ns) {
+    if (now_ns >= next_update_ns_) {
+        take_device_topics();
+        next_update_ns_ = next_period_boundary(now_ns, period_ns_);
+        wire_.put_inputs(signals_, next_update_ns_ - now_ns);
+    }
+    publish_outputs(now_ns);
+    return next_update_ns_;
+}
+
+}  // namespace rig
