@@ -63,7 +63,7 @@ struct ControllerConfig {
     double flow_meter_pulses_per_l = 90.0;
     double flow_window_s = 0.25;
     // Eq. 8: pump-outlet sensor range Q_F and the converter's voltage span u.
-    double pump_sensor_full_scale_m3_h = 6.0;
+    double pump_sensor_full_scale_m3_h = 8.0;  // WL-LWGA-20: 0.8-8 m^3/h
     double pump_sensor_span_v = 3.3;
     double pump_flow_smoothing_s = 0.5;     // the plunger pump pulsates; average before use
     // Pull-wire boom-height sensor: h at full span (Eq. 6 uses h).

@@ -14,6 +14,12 @@ void FlowRateMeter::reset() {
 
 void FlowRateMeter::add_count(std::uint32_t count_pulses, std::optional<std::uint32_t> last_edge_capture_us,
                               TimeNs now_ns) {
+    // Capture times and read times are two time lines: a wire that switches between
+    // them starts the measurement over rather than mixing them.
+    if (last_count_ && last_edge_capture_us.has_value() != last_capture_us_.has_value()) {
+        edges_.clear();
+        last_capture_us_.reset();
+    }
     if (last_edge_capture_us) {
         // Unsigned differences survive the 32-bit wrap of the timer, as of the counter.
         if (last_capture_us_) unwrapped_capture_us_ += static_cast<std::uint32_t>(*last_edge_capture_us - *last_capture_us_);

@@ -36,6 +36,8 @@ void SprayController::start(TimeNs now_ns) {
     actuators_.unloading_valve_open = true;
     actuators_.section_valves_open = 0;
     valve_.start_reset(now_ns);
+    actuators_.ball_valve_forward = valve_.drive() == RelayDrive::forward;
+    actuators_.ball_valve_reverse = valve_.drive() == RelayDrive::reverse;
     enter(msg::SPRAY_VALVE_RESET, now_ns);
     next_pid_ns_ = now_ns;
 }

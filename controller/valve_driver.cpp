@@ -10,12 +10,7 @@ ValveDriver::ValveDriver(const ValveDriverParams& params) : params_(params) {}
 void ValveDriver::set_drive(RelayDrive drive, TimeNs now_ns) {
     advance_belief(now_ns);
     if (drive == drive_) return;
-    const int direction = drive == RelayDrive::forward ? 1 : drive == RelayDrive::reverse ? -1 : 0;
-    if (direction != 0) {
-        start_delay_left_s_ = params_.start_delay_s;
-        if (last_direction_ != 0 && direction != last_direction_) backlash_left_pct_ = params_.backlash_pct;
-        last_direction_ = direction;
-    }
+    if (drive != RelayDrive::off) start_delay_left_s_ = params_.start_delay_s;
     drive_ = drive;
 }
 
@@ -27,12 +22,24 @@ void ValveDriver::advance_belief(TimeNs now_ns) {
         start_delay_left_s_ -= lost_s;
         run_s -= lost_s;
         double travel_pct = run_s * 100.0 / params_.travel_s;
-        const double play_pct = std::min(travel_pct, backlash_left_pct_);
-        backlash_left_pct_ -= play_pct;
-        travel_pct -= play_pct;
-        believed_pct_ = std::clamp(believed_pct_ + (drive_ == RelayDrive::forward ? travel_pct : -travel_pct), 0.0, 100.0);
+        if (travel_pct > 0.0) {
+            const bool opening = drive_ == RelayDrive::forward;
+            if (!play_known_) {
+                play_pct_ = opening ? params_.backlash_pct : 0.0;
+                play_known_ = true;
+            }
+            const double crossed_pct = std::min(travel_pct, play_to_cross_pct(drive_));
+            play_pct_ += opening ? crossed_pct : -crossed_pct;
+            travel_pct -= crossed_pct;
+            believed_pct_ = std::clamp(believed_pct_ + (opening ? travel_pct : -travel_pct), 0.0, 100.0);
+        }
     }
     drive_since_ns_ = now_ns;
+}
+
+double ValveDriver::play_to_cross_pct(RelayDrive drive) const {
+    if (!play_known_ || drive == RelayDrive::off) return 0.0;
+    return drive == RelayDrive::forward ? params_.backlash_pct - play_pct_ : play_pct_;
 }
 
 void ValveDriver::start_reset(TimeNs now_ns) {
@@ -60,7 +67,8 @@ void ValveDriver::plan_move(TimeNs now_ns) {
     const RelayDrive wanted = error_pct > 0 ? RelayDrive::forward : RelayDrive::reverse;
     set_drive(wanted, now_ns);
     // Run long enough to cover the start delay and backlash still to come, then the distance.
-    const double run_s = start_delay_left_s_ + (backlash_left_pct_ + std::abs(error_pct)) * params_.travel_s / 100.0;
+    const double run_s =
+        start_delay_left_s_ + (play_to_cross_pct(wanted) + std::abs(error_pct)) * params_.travel_s / 100.0;
     next_event_ns_ = now_ns + std::max<TimeNs>(1, seconds_to_ns(run_s));
 }
 
@@ -71,7 +79,8 @@ void ValveDriver::update(TimeNs now_ns) {
         case ResetPhase::opening:
             // Against the end stop now (believed): drive back for reset_back_s.
             believed_pct_ = 100.0;
-            backlash_left_pct_ = 0.0;
+            play_pct_ = params_.backlash_pct;  // pushed against the stop
+            play_known_ = true;
             reset_phase_ = ResetPhase::closing;
             set_drive(RelayDrive::reverse, now_ns);
             next_event_ns_ = now_ns + seconds_to_ns(params_.reset_back_s);

@@ -8,7 +8,9 @@
 // Reset (seed 000 sec. 2.2.2): "the control valve to the maximum flow rate for
 // 5 s ... to ensure that the control valve has been opened to the maximum, and
 // then it is adjusted in the opposite direction for 2 s": afterwards the valve is
-// believed at 100 - 2 / travel_s x 100 % (81.8 % for 11 s travel), whatever it was.
+// believed at 100 - (2 - start_delay) / travel_s x 100 + backlash % (81.8 % for
+// an ideal 11 s valve; 82.3 % with the default 20 ms start delay and 0.3 % play),
+// whatever it was before.
 #include <optional>
 
 #include "rig/clock.h"
@@ -61,8 +63,11 @@ private:
     std::optional<double> target_pct_;
     TimeNs drive_since_ns_ = 0;       // belief integrated up to here
     double start_delay_left_s_ = 0.0;
-    double backlash_left_pct_ = 0.0;
-    int last_direction_ = 0;
+    // Where the motor is believed inside the gear play (see emulators/ball_valve.h):
+    // 0 = pushing towards closed, backlash_pct = towards open.
+    double play_pct_ = 0.0;
+    bool play_known_ = false;
+    double play_to_cross_pct(RelayDrive drive) const;
     TimeNs next_event_ns_ = kNever;
 };
 

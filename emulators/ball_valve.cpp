@@ -21,12 +21,9 @@ BallValve::BallValve(const BallValveParams& params) : params_(params), opening_p
 void BallValve::set_drive(Drive drive) {
     if (drive == drive_) return;
     if (drive == Drive::both) ++both_relays_events_;
-    const int direction = drive == Drive::forward ? 1 : drive == Drive::reverse ? -1 : 0;
-    if (direction != 0) {
-        start_delay_left_s_ = params_.motor_start_delay_s;
-        if (last_direction_ != 0 && direction != last_direction_) backlash_left_pct_ = params_.backlash_pct;
-        last_direction_ = direction;
-    }
+    // Every relay closure costs the motor its start delay; the play is only
+    // crossed once the motor really turns (step()).
+    if (drive == Drive::forward || drive == Drive::reverse) start_delay_left_s_ = params_.motor_start_delay_s;
     drive_ = drive;
 }
 
@@ -37,11 +34,18 @@ void BallValve::step(double dt_s) {
     start_delay_left_s_ -= lost_s;
     run_s -= lost_s;
     double travel_pct = run_s * 100.0 / params_.travel_s;
-    const double play_pct = std::min(travel_pct, backlash_left_pct_);
-    backlash_left_pct_ -= play_pct;
-    travel_pct -= play_pct;
-    const double direction = drive_ == Drive::forward ? 1.0 : -1.0;
-    opening_pct_ = std::clamp(opening_pct_ + direction * travel_pct, 0.0, 100.0);
+    if (travel_pct <= 0.0) return;
+    const bool opening = drive_ == Drive::forward;
+    if (!play_known_) {
+        play_pct_ = opening ? params_.backlash_pct : 0.0;
+        play_known_ = true;
+    }
+    // First cross what is left of the play, then the ball turns.
+    const double play_to_cross_pct = opening ? params_.backlash_pct - play_pct_ : play_pct_;
+    const double crossed_pct = std::min(travel_pct, play_to_cross_pct);
+    play_pct_ += opening ? crossed_pct : -crossed_pct;
+    travel_pct -= crossed_pct;
+    opening_pct_ = std::clamp(opening_pct_ + (opening ? travel_pct : -travel_pct), 0.0, 100.0);
 }
 
 }  // namespace rig::emulators

@@ -10,8 +10,12 @@
 //   - start delay: each time a relay closes, the motor needs motor_start_delay_s
 //     (relay pull-in, spin-up) before the ball moves: short pulses move less than
 //     their length, pulses shorter than it not at all (the valve's deadband);
-//   - backlash: after a change of direction the first backlash_pct of motor
-//     travel only takes up the gear play.
+//   - backlash: the gear train has backlash_pct of play. The motor moves the
+//     ball only with the play taken up on the side it pushes: after a reversal
+//     the first backlash_pct of motor travel (less, if the play was only partly
+//     crossed) turns nothing. The play is tracked, so a pulse too short to turn
+//     the motor changes nothing. At power-on it is taken up on whichever side
+//     the first drive pushes (where the last run left it).
 //   - both relays on: the motor is shorted (braked), nothing moves; counted as a
 //     wiring fault.
 #include <cstdint>
@@ -22,7 +26,10 @@ struct BallValveParams {
     double travel_s = 11.0;              // closed -> fully open
     double motor_start_delay_s = 0.02;   // lost at every relay closure
     double backlash_pct = 0.3;           // of full travel, taken up on a reversal
-    double initial_opening_pct = 40.0;   // where the ball is at power-on
+    // Where the ball is at power-on. The reset (open 5 s, back 2 s) reaches the end
+    // stop only from above 54.5 % (5 s of 11 s travel): a lower value is the
+    // fault of a valve left nearly closed.
+    double initial_opening_pct = 85.0;
 };
 
 class BallValve {
@@ -45,8 +52,10 @@ private:
     double opening_pct_;
     Drive drive_ = Drive::off;
     double start_delay_left_s_ = 0.0;
-    double backlash_left_pct_ = 0.0;
-    int last_direction_ = 0;   // +1 opening, -1 closing, 0 never moved
+    // Where the motor sits inside the play: 0 = pushing towards closed, backlash_pct
+    // = pushing towards open. Unknown until the motor first turns.
+    double play_pct_ = 0.0;
+    bool play_known_ = false;
     std::uint32_t both_relays_events_ = 0;
 };
 

@@ -32,6 +32,21 @@ FlowMap::FlowMap(FlowMapParams params) : params_(std::move(params)) {
     if (!(params_.zero_flow_opening_pct < lines.front().opening_pct)) {
         throw std::invalid_argument("flow map: zero_flow_opening_pct must be below the lowest calibrated opening");
     }
+    // The bulge must not bend the curve back down: a valve whose flow falls as it
+    // opens would make every controller's search diverge, and no real one does.
+    for (double pump : {30.0, 55.0, 81.0}) {
+        double previous = calibrated_line_l_min(lines.front().opening_pct, pump);
+        for (double opening = lines.front().opening_pct + 0.05; opening <= lines.back().opening_pct; opening += 0.05) {
+            const double flow = calibrated_line_l_min(opening, pump);
+            if (flow < previous) {
+                throw std::invalid_argument("flow map: interpolation_bulge_pct " +
+                                            std::to_string(params_.interpolation_bulge_pct) +
+                                            " makes the flow fall with opening near " + std::to_string(opening) +
+                                            " % at " + std::to_string(pump) + " L/min pump flow");
+            }
+            previous = flow;
+        }
+    }
 }
 
 double FlowMap::calibrated_line_l_min(double opening_pct, double pump_flow_l_min) const {

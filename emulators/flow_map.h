@@ -42,7 +42,8 @@ struct FlowMapParams {
 class FlowMap {
 public:
     // Throws std::invalid_argument unless the lines are sorted by opening, at
-    // least two, and give a flow rising with opening at every pump flow in 30-81 L/min.
+    // least two, and give a flow rising with opening at every pump flow in 30-81 L/min,
+    // with the bulge too.
     explicit FlowMap(FlowMapParams params);
     // Main-pipeline flow with every nozzle open, L/min (>= 0).
     double main_flow_l_min(double opening_pct, double pump_flow_l_min) const;

@@ -6,12 +6,25 @@ namespace rig::emulators {
 
 PanelSwitch::PanelSwitch(std::string node_name, std::string topic, std::vector<SwitchClosure> closures)
     : name_(std::move(node_name)), topic_(std::move(topic)) {
-    edges_.push_back(Edge{0, false});
+    // Overlapping closures are one longer closure (a finger held down), not a
+    // release in the middle of the second one.
+    std::sort(closures.begin(), closures.end(),
+              [](const SwitchClosure& a, const SwitchClosure& b) { return a.at_s < b.at_s; });
+    std::vector<std::pair<TimeNs, TimeNs>> merged;
     for (const SwitchClosure& closure : closures) {
-        edges_.push_back(Edge{seconds_to_ns(closure.at_s), true});
-        edges_.push_back(Edge{seconds_to_ns(closure.at_s + closure.hold_s), false});
+        const TimeNs from = seconds_to_ns(closure.at_s);
+        const TimeNs to = seconds_to_ns(closure.at_s + closure.hold_s);
+        if (!merged.empty() && from <= merged.back().second) {
+            merged.back().second = std::max(merged.back().second, to);
+        } else {
+            merged.emplace_back(from, to);
+        }
     }
-    std::stable_sort(edges_.begin(), edges_.end(), [](const Edge& a, const Edge& b) { return a.at_ns < b.at_ns; });
+    edges_.push_back(Edge{0, false});
+    for (const auto& [from, to] : merged) {
+        edges_.push_back(Edge{from, true});
+        edges_.push_back(Edge{to, false});
+    }
 }
 
 void PanelSwitch::configure(DdsContext& dds) { level_writer_ = std::make_unique<Writer<msg::SwitchLevel>>(dds, topic_); }

@@ -20,7 +20,7 @@
 namespace rig::emulators {
 
 struct PumpFlowSensorParams {
-    double full_scale_m3_h = 6.0;   // Q_F: 100 L/min, above the pump's 81 L/min
+    double full_scale_m3_h = 8.0;   // Q_F: the paper's WL-LWGA-20 turbine reads 0.8-8 m^3/h (133 L/min)
     double noise_mv = 2.0;
     double offset_ma = 0.0;
     double rate_hz = 20.0;

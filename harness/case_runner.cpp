@@ -463,7 +463,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
                                                  spec.encoder.rate_hz});
         emulators::FlowMeterKf11 flow_meter(
             circuit, emulators::Kf11Params{spec.flow_meter.pulses_per_l, spec.flow_meter.k_factor_error_pct, 0.27,
-                                           14.14, spec.flow_meter.rate_hz});
+                                           spec.flow_meter.rate_hz});
         emulators::PumpFlowSensor pump_sensor(
             circuit, emulators::PumpFlowSensorParams{spec.pump_sensor.full_scale_m3_h, spec.pump_sensor.noise_mv,
                                                      spec.pump_sensor.offset_ma, spec.pump_sensor.rate_hz, result.seed});

@@ -158,7 +158,7 @@ struct FlowMeterSpec {
 };
 
 struct PumpSensorSpec {
-    double full_scale_m3_h = 6.0;            // Q_F of Eq. 8
+    double full_scale_m3_h = 8.0;            // Q_F of Eq. 8: WL-LWGA-20 turbine, 0.8-8 m^3/h (sec. 2.2.2)
     double noise_mv = 2.0;
     double offset_ma = 0.0;
     double rate_hz = 20.0;

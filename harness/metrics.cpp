@@ -115,12 +115,14 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
     const std::size_t rows = std::max(profile.first_pass.size(), profile.continuation.size());
     const double threshold = judging.sprayed_fraction * judging.nominal_dose_ul_cm2;
     auto dose = [](const std::vector<double>& layer, std::size_t row) { return row < layer.size() ? layer[row] : 0.0; };
+    // The one definition of "sprayed": at or above the threshold.
+    auto sprayed = [&](const std::vector<double>& layer, std::size_t row) { return dose(layer, row) >= threshold; };
     std::vector<double> total(rows);
     std::optional<std::size_t> first_sprayed, last_sprayed, first_both, last_both;
     double overlap_m = 0.0;
     for (std::size_t row = 0; row < rows; ++row) {
-        const bool first = dose(profile.first_pass, row) >= threshold;
-        const bool second = dose(profile.continuation, row) >= threshold;
+        const bool first = sprayed(profile.first_pass, row);
+        const bool second = sprayed(profile.continuation, row);
         total[row] = dose(profile.first_pass, row) + dose(profile.continuation, row);
         if (first || second) {
             if (!first_sprayed) first_sprayed = row;
@@ -136,8 +138,7 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
     std::optional<std::size_t> gap_start;
     if (first_sprayed) {
         for (std::size_t row = *first_sprayed; row <= *last_sprayed; ++row) {
-            const bool sprayed = dose(profile.first_pass, row) >= threshold || dose(profile.continuation, row) >= threshold;
-            if (!sprayed) {
+            if (!sprayed(profile.first_pass, row) && !sprayed(profile.continuation, row)) {
                 missed_m += profile.row_m;
                 if (!gap_start) gap_start = row;
             } else if (gap_start) {

@@ -68,7 +68,7 @@ struct DoseProfile {
 
 struct DepositionJudging {
     double nominal_dose_ul_cm2 = 0.0;   // target flow / (cruise speed x boom width)
-    double sprayed_fraction = 0.5;      // a row is sprayed above this share of nominal
+    double sprayed_fraction = 0.5;      // a row is sprayed at or above this share of nominal
     double cv_row_m = 0.3;              // rows of Eq. 10-12
     double cv_window_m = 6.0;
 };
