@@ -14,6 +14,8 @@
 //   --nmea-serial PATH [--nmea-baud N]        the G970II's RS232 line
 //   --modbus-rtu PATH [--modbus-baud N] [--modbus-parity N|E|O] [--modbus-slave-id N]
 //   --modbus-tcp ADDRESS:PORT                 the board's I/O through the rig's register map
+// Fault injection: --stall-at-s T stops answering the clock at simulated time T
+// (the rig must then fail the case by the node's name, in bounded time).
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -52,6 +54,9 @@ int main(int argc, char** argv) {
     app.add_option("--modbus-parity", modbus_parity, "wired mode: Modbus RTU parity")->check(CLI::IsMember({"N", "E", "O"}));
     app.add_option("--modbus-slave-id", modbus_slave_id, "wired mode: Modbus slave id")->check(CLI::Range(1, 247));
     app.add_option("--modbus-tcp", modbus_tcp, "wired mode: ADDRESS:PORT of the rig's Modbus TCP slave");
+    double stall_at_s = -1.0;
+    app.add_option("--stall-at-s", stall_at_s,
+                   "fault injection (lockstep): stop answering the clock from this simulated time on");
     CLI11_PARSE(app, argc, argv);
 
     const bool wired_mode = !wired.nmea_port.empty() || !modbus_rtu_device.empty() || !modbus_tcp.empty();
@@ -59,6 +64,7 @@ int main(int argc, char** argv) {
         const auto config = rig::controller::load_controller_config(config_file);
         rig::FollowerOptions options;
         options.node_name = node_name;
+        if (stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(stall_at_s);
         rig::DdsContext dds(domain_id, node_name);
         if (wired_mode) {
             if (clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");

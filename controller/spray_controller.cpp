@@ -203,8 +203,13 @@ double SprayController::speed_m_s() const {
            3.6;
 }
 
-bool SprayController::moving_fast_enough() const {
-    return config_.min_spray_speed_km_h <= 0.0 || speed_m_s() * 3.6 >= config_.min_spray_speed_km_h;
+bool SprayController::moving_fast_enough(bool spraying) const {
+    if (config_.min_spray_speed_km_h <= 0.0) return true;
+    // Hysteresis: Eq. 5 over 0.2 s is noisy at walking pace, and a shutoff that
+    // chatters would click the section valves open and shut. Sections open at the
+    // minimum speed and close below 80 % of it.
+    const double threshold_km_h = config_.min_spray_speed_km_h * (spraying ? 0.8 : 1.0);
+    return speed_m_s() * 3.6 >= threshold_km_h;
 }
 
 std::uint16_t SprayController::all_sections_mask() const {
@@ -296,13 +301,13 @@ TimeNs SprayController::update(TimeNs now_ns) {
         case msg::SPRAY_PRE_ADJUST:
             if (!spray_switch_on_) {
                 enter(msg::SPRAY_IDLE, now_ns);
-            } else if (valve_.idle() && moving_fast_enough()) {
+            } else if (valve_.idle() && moving_fast_enough(false)) {
                 open_sections(now_ns);
                 enter(msg::SPRAY_REGULATING, now_ns);
             }
             break;
         case msg::SPRAY_REGULATING:
-            if (!spray_switch_on_ || !moving_fast_enough()) {
+            if (!spray_switch_on_ || !moving_fast_enough(true)) {
                 // Zero-speed shutoff (or switch off): the valve stays where the PID left it.
                 close_sections(now_ns);
                 enter(spray_switch_on_ ? msg::SPRAY_PRE_ADJUST : msg::SPRAY_IDLE, now_ns);

@@ -93,7 +93,8 @@ private:
     void select_target();
     void publish_event(msg::BreakpointEventKind kind, const StoredBreakpoint& breakpoint, TimeNs now_ns);
     double speed_m_s() const;
-    bool moving_fast_enough() const;
+    // Above the zero-speed shutoff (with hysteresis: `spraying` = the sections are open).
+    bool moving_fast_enough(bool spraying) const;
     std::uint16_t all_sections_mask() const;
 
     void enter(msg::SprayPhase phase, TimeNs now_ns);

@@ -36,7 +36,7 @@ struct FlowMapParams {
     double zero_flow_opening_pct = 60.0;
     double max_fraction_of_pump = 0.95;
     double interpolation_bulge_pct = 3.0;
-    double calibration_drift_pct = 1.5;
+    double calibration_drift_pct = 1.0;
 };
 
 class FlowMap {

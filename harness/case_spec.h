@@ -136,13 +136,13 @@ struct HydraulicsSpec {
     double pump_flow_l_min = 31.1;           // (0, 200]
     double pump_pulsation_pct = 2.0;         // [0, 50]
     double pump_pulsation_hz = 27.0;         // > 0
-    double pipeline_time_constant_s = 0.25;  // (0, 10]
+    double pipeline_time_constant_s = 0.30;  // (0, 10]
     double valve_travel_s = 11.0;            // sec. 3.1.2: closed -> open in 11 s
     double valve_backlash_pct = 0.3;
     double valve_motor_start_delay_s = 0.02;
     double valve_initial_opening_pct = 85.0;
     double interpolation_bulge_pct = 3.0;
-    double calibration_drift_pct = 1.5;
+    double calibration_drift_pct = 1.0;
     std::vector<int> section_nozzles = {8, 6, 8};   // 22 nozzles
     double boom_width_m = 12.2;
     double section_valve_open_s = 0.200;     // Table 1 t3

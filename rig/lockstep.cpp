@@ -380,6 +380,11 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
             link->final_ack(tick->seq(), "");
             return 0;
         }
+        if (tick->time_ns() >= options.stall_at_ns) {
+            std::cerr << options.node_name << ": stalling at t=" << format_time(tick->time_ns())
+                      << " as asked (--stall-at-s)\n";
+            for (;;) RealtimeClock().sleep_until_ns(seconds_to_ns(3600.0));  // until the harness kills us
+        }
         clock.set_ns(tick->time_ns());
         // Counted delivery: everything published so far must be in our readers
         // before we take our inputs (a sample published at t is seen at t).

@@ -127,6 +127,9 @@ struct FollowerOptions {
     std::chrono::milliseconds idle_timeout{120'000};
     std::chrono::milliseconds startup_timeout{30'000};
     std::chrono::milliseconds delivery_timeout{10'000};
+    // Fault injection (bench and tests): from this simulated time on, stop
+    // answering ticks, like a wedged firmware loop. kNever = never.
+    TimeNs stall_at_ns = kNever;
 };
 
 // The node side of the clock protocol, shared by the lockstep follower and the

@@ -92,12 +92,11 @@ TEST(NegativeCases, SuitePassesWhenExactlyTheExpectedMetricsBreak) {
     ASSERT_NE(gains_x5, nullptr) << results.dump(2);
     EXPECT_EQ(gains_x5->at("passed"), true);
     EXPECT_EQ(gains_x5->at("expected_failure"), true);
-    EXPECT_EQ(failing_metrics(*gains_x5), (std::set<std::string>{"flow_adjust_time_s", "flow_error_pct"}))
-        << gains_x5->dump(2);
+    EXPECT_EQ(failing_metrics(*gains_x5), (std::set<std::string>{"flow_adjust_time_s"})) << gains_x5->dump(2);
     EXPECT_GT(gains_x5->at("metrics").at("flow_adjust_time_s").get<double>(),
               gains_x5->at("limits").at("flow_adjust_time_s").get<double>());
-    EXPECT_GT(gains_x5->at("metrics").at("flow_error_pct").get<double>(),
-              gains_x5->at("limits").at("flow_error_pct").get<double>());
+    // Not a near miss: it swings for seconds (the paper gains settle in about 1 s).
+    EXPECT_GT(gains_x5->at("metrics").at("flow_adjust_time_s").get<double>(), 5.0);
 }
 
 TEST(NegativeCases, NoCompensationWithoutItsExpectationFailsTheRun) {

@@ -303,6 +303,7 @@ SprayCircuitParams quiet_circuit(double opening_pct) {
     params.pump_pulsation_pct = 0.0;
     params.flow_map = calibrated_truth();
     params.valve.initial_opening_pct = opening_pct;
+    params.pipeline_time_constant_s = 0.25;  // the numbers worked by hand below use this lag
     return params;
 }
 
