@@ -25,6 +25,9 @@ void read_flow_control(const YamlSection& section, ControllerConfig& config) {
     config.pid.ki = pid.optional_in_range("ki", config.pid.ki, Bounds::closed(0.0, 100.0));
     config.pid.kd = pid.optional_in_range("kd", config.pid.kd, Bounds::closed(0.0, 100.0));
     config.pid_period_s = pid.optional_in_range("period_s", config.pid_period_s, Bounds::closed(0.01, 5.0));
+    static constexpr std::array<EnumChoice<PidOutput>, 2> kPidOutputs{
+        {{"flow_l_min", PidOutput::flow_l_min}, {"opening_pct", PidOutput::opening_pct}}};
+    config.pid_output = pid.optional_enum<PidOutput>("output", kPidOutputs, config.pid_output);
     config.pid_integral_limit_l_min =
         pid.optional_in_range("integral_limit_l_min", config.pid_integral_limit_l_min, Bounds::open_closed(0.0, 250.0));
     config.flow_established_change_pct = pid.optional_in_range(

@@ -18,6 +18,11 @@ class YamlSection;
 namespace rig::controller {
 
 enum class Positioning { rtk_only, fusion };
+// What Eq. 2's output M is (the paper does not say): a flow correction in L/min,
+// through the calibration to an opening (the loop gain does not depend on where
+// on the valve curve it works), or a change of the opening in % from the
+// pre-adjusted one (the loop gain follows the curve's steepness, 1-4 L/min per %).
+enum class PidOutput { flow_l_min, opening_pct };
 
 struct ControllerConfig {
     Positioning positioning = Positioning::fusion;
@@ -50,6 +55,7 @@ struct ControllerConfig {
     double assumed_flow_adjust_s = 1.359;   // t2: Table 2 mean adjust time
     double assumed_spray_delay_s = 0.267;   // t3: Table 1, signal -> droplets landing
     PidGains pid{};                         // Eq. 2, sec. 3.1.2
+    PidOutput pid_output = PidOutput::flow_l_min;
     double pid_period_s = 0.1;
     double pid_integral_limit_l_min = 5.0;
     // The PID starts once the measured flow has settled after the sections opened:

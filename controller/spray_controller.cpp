@@ -237,6 +237,7 @@ void SprayController::close_sections(TimeNs /*now_ns*/) {
 void SprayController::start_pre_adjust(TimeNs now_ns) {
     if (!pump_flow_l_min_) return;  // no pump flow reading yet: wait
     valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
+    pre_adjusted_pct_ = valve_command_pct_;
     valve_.move_to(valve_command_pct_, now_ns);
     pid_.reset();
     enter(msg::SPRAY_PRE_ADJUST, now_ns);
@@ -269,7 +270,11 @@ void SprayController::regulate(TimeNs now_ns) {
 
     const double error_l_min = config_.target_flow_l_min - *measured;
     const double correction_l_min = pid_.update(error_l_min);
-    valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min + correction_l_min, *pump_flow_l_min_);
+    if (config_.pid_output == PidOutput::opening_pct) {
+        valve_command_pct_ = std::clamp(pre_adjusted_pct_ + correction_l_min, 0.0, 100.0);
+    } else {
+        valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min + correction_l_min, *pump_flow_l_min_);
+    }
     valve_.move_to(valve_command_pct_, now_ns);
 
     if (std::abs(error_l_min) <= config_.on_target_band_pct / 100.0 * config_.target_flow_l_min) {
@@ -326,6 +331,7 @@ TimeNs SprayController::update(TimeNs now_ns) {
         case msg::SPRAY_APPROACH:
             if (!valve_.resetting() && !valve_.target_pct() && pump_flow_l_min_) {
                 valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
+                pre_adjusted_pct_ = valve_command_pct_;
                 valve_.move_to(valve_command_pct_, now_ns);
                 pid_.reset();
             }

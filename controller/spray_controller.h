@@ -138,6 +138,7 @@ private:
     std::optional<TimeNs> on_target_since_ns_;
     bool continuation_on_target_ = false;
     double valve_command_pct_ = 0.0;
+    double pre_adjusted_pct_ = 0.0;       // the opening the calibration gave for the target
     TimeNs next_pid_ns_ = 0;
     bool started_ = false;
 

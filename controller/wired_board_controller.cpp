@@ -99,13 +99,18 @@ void WiredBoardController::write_outputs() {
 }
 
 TimeNs WiredBoardController::step(TimeNs now_ns) {
+    // Outputs first, inputs after: a relay change must reach the wire at the
+    // instant the firmware decided it, not one Modbus read later. (Polled first,
+    // every relay-on that follows a PID decision went out a read transaction
+    // late while its relay-off did not, so short valve pulses came out shorter
+    // than planned and a correction within the motor's start delay did nothing.)
     read_nmea(now_ns);
+    const TimeNs firmware_wake = firmware_.update(now_ns);
+    write_outputs();
     if (now_ns >= next_poll_ns_) {
         poll_board(now_ns);
         next_poll_ns_ = next_period_boundary(now_ns, poll_period_ns_);
     }
-    const TimeNs firmware_wake = firmware_.update(now_ns);
-    write_outputs();
     for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
     firmware_.take_events();  // on this wire the events reach the rig as the indicator counters
     return std::min(firmware_wake, next_poll_ns_);

@@ -7,8 +7,9 @@
 //
 // It is a rig::Node only so the real-time follower can start and stop it with
 // the harness; it has no DDS endpoints of its own. Each step reads what the
-// serial port holds, polls the board inputs (one FC 04 + one FC 02), runs the
-// firmware and writes the coils / holding registers that changed.
+// serial port holds, runs the firmware, writes the coils / holding registers
+// that changed, and then polls the board inputs (one FC 04 + one FC 02) for the
+// next step.
 #include <chrono>
 #include <filesystem>
 #include <memory>

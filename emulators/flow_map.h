@@ -35,7 +35,7 @@ struct FlowMapParams {
     std::vector<OpeningFlowLine> lines = paper_opening_flow_lines();
     double zero_flow_opening_pct = 60.0;
     double max_fraction_of_pump = 0.95;
-    double interpolation_bulge_pct = 3.0;
+    double interpolation_bulge_pct = 2.0;
     double calibration_drift_pct = 1.0;
 };
 

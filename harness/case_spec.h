@@ -141,7 +141,7 @@ struct HydraulicsSpec {
     double valve_backlash_pct = 0.3;
     double valve_motor_start_delay_s = 0.02;
     double valve_initial_opening_pct = 85.0;
-    double interpolation_bulge_pct = 3.0;
+    double interpolation_bulge_pct = 2.0;
     double calibration_drift_pct = 1.0;
     std::vector<int> section_nozzles = {8, 6, 8};   // 22 nozzles
     double boom_width_m = 12.2;
