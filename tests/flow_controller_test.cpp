@@ -294,16 +294,18 @@ TEST(ValveDriver, MovePlansRelayAndDurationWithStartDelayAndBacklash) {
 TEST(ValveDriver, MovesSmallerThanTheDeadbandCloseNoRelay) {
     ValveDriver driver = reset_driver();
     const double start = driver.believed_opening_pct();
-    driver.move_to(start + 0.04, 8 * kS);  // deadband 0.05 %
+    const double deadband = ValveDriverParams{}.deadband_pct;
+    driver.move_to(start + 0.8 * deadband, 8 * kS);
     EXPECT_EQ(driver.drive(), RelayDrive::off);
     EXPECT_EQ(driver.next_event_ns(), rig::kNever);
     EXPECT_EQ(driver.believed_opening_pct(), start);
-    driver.move_to(start - 0.04, 8 * kS);
+    driver.move_to(start - 0.8 * deadband, 8 * kS);
     EXPECT_EQ(driver.drive(), RelayDrive::off);
-    driver.move_to(start + 0.06, 8 * kS);
+    driver.move_to(start + 1.2 * deadband, 8 * kS);
     EXPECT_EQ(driver.drive(), RelayDrive::forward);
-    // 0.02 s + (0.3 backlash + 0.06) x 0.11 s.
-    EXPECT_NEAR(static_cast<double>(driver.next_event_ns() - 8 * kS), (0.02 + 0.36 * 0.11) * 1e9, 2.0);
+    // 0.02 s + (0.3 backlash + 1.2 deadband) x 0.11 s.
+    EXPECT_NEAR(static_cast<double>(driver.next_event_ns() - 8 * kS), (0.02 + (0.3 + 1.2 * deadband) * 0.11) * 1e9,
+                2.0);
 }
 
 TEST(ValveDriver, MoveIsIgnoredWhileResetting) {
