@@ -13,51 +13,11 @@
 #include <optional>
 
 #include "rig/pty_pair.h"
+#include "rig/stop_signals.h"
 #include "rig/serial_port.h"
 
 namespace rig::harness {
 namespace {
-
-// SIGINT and SIGTERM as readable events on a descriptor. They are blocked in
-// the calling thread before any other thread starts (the PtyLink forwarder
-// inherits the mask), so the signal only ever arrives here; the previous mask
-// is restored when this goes away.
-class StopSignals {
-public:
-    StopSignals() {
-        sigemptyset(&signals_);
-        sigaddset(&signals_, SIGINT);
-        sigaddset(&signals_, SIGTERM);
-        if (::pthread_sigmask(SIG_BLOCK, &signals_, &previous_) != 0) {
-            throw std::runtime_error("pthread_sigmask failed");
-        }
-        fd_ = ::signalfd(-1, &signals_, SFD_CLOEXEC);
-        if (fd_ < 0) {
-            const int error = errno;
-            ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
-            throw std::runtime_error(std::string("signalfd: ") + std::strerror(error));
-        }
-    }
-    ~StopSignals() {
-        ::close(fd_);
-        ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
-    }
-    StopSignals(const StopSignals&) = delete;
-    StopSignals& operator=(const StopSignals&) = delete;
-    int fd() const { return fd_; }
-    // The name of the signal that arrived ("SIGTERM").
-    std::string take() const {
-        signalfd_siginfo info{};
-        const ssize_t n = ::read(fd_, &info, sizeof info);
-        if (n != static_cast<ssize_t>(sizeof info)) return "signal";
-        return info.ssi_signo == SIGINT ? "SIGINT" : "SIGTERM";
-    }
-
-private:
-    sigset_t signals_{};
-    sigset_t previous_{};
-    int fd_ = -1;
-};
 
 std::string path_line(const char* label, const PtyPair& pty) {
     std::string line = std::string(label) + pty.slave_path();

@@ -50,13 +50,6 @@ constexpr double kVehicleTruthRateHz = 20.0;
 constexpr double kHydraulicsTruthRateHz = 100.0;
 constexpr double kForeverS = 1e6;
 
-struct ScenarioPlan {
-    std::vector<emulators::RoutePhase> route;
-    double start_along_m = 0.0;  // nozzle line at t = 0
-    std::vector<emulators::SwitchClosure> button;
-    std::vector<emulators::SwitchClosure> spray_switch;
-    double approach_starts_s = 0.0;
-};
 
 ScenarioPlan build_scenario(const CaseSpec& spec, const emulators::BoomGeometry& boom) {
     const double bp = spec.breakpoint.along_m;
@@ -156,6 +149,36 @@ emulators::G970Params gnss_params(const CaseSpec& spec, std::uint64_t seed, doub
     params.seed = seed;
     return params;
 }
+
+}  // namespace
+
+CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed) {
+    emulators::PlantParams plant_params;
+    plant_params.origin_lat_deg = spec.field.origin.lat_deg;
+    plant_params.origin_lon_deg = spec.field.origin.lon_deg;
+    plant_params.origin_height_m = spec.field.origin.height_m;
+    plant_params.heading_deg = spec.field.heading_deg;
+    plant_params.boom =
+        emulators::BoomGeometry{spec.boom.l1_m, spec.boom.l2_m, spec.boom.l3_m, spec.boom.linkage_rise_m};
+    ScenarioPlan scenario = build_scenario(spec, plant_params.boom);
+    plant_params.route = scenario.route;
+    plant_params.start_nozzle_line_along_m = scenario.start_along_m;
+    plant_params.wheel.slip_pct = spec.encoder.slip_pct;
+    plant_params.wheel.slip_sd_pct = spec.encoder.slip_sd_pct;
+    plant_params.wheel.deflection_pct = spec.encoder.deflection_pct;
+    plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
+    plant_params.seed = seed;
+    emulators::Plant plant(plant_params);
+    const double crossing_s = spec.scenario == Scenario::static_flow
+                                  ? std::numeric_limits<double>::quiet_NaN()
+                                  : plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m,
+                                                                                  scenario.approach_starts_s);
+    const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
+    emulators::G970Params gnss = gnss_params(spec, seed, crossing_s);
+    return CaseWorld{std::move(plant), std::move(scenario), std::move(gnss), crossing_s, end_ns};
+}
+
+namespace {
 
 // The controller's parameters as their own YAML file (the case section minus `command`).
 void write_controller_config(const CaseSpec& spec, const std::filesystem::path& file) {
@@ -396,29 +419,11 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
         std::filesystem::remove_all(case_dir);
         std::filesystem::create_directories(case_dir / "controller-state");
 
-        emulators::PlantParams plant_params;
-        plant_params.origin_lat_deg = spec.field.origin.lat_deg;
-        plant_params.origin_lon_deg = spec.field.origin.lon_deg;
-        plant_params.origin_height_m = spec.field.origin.height_m;
-        plant_params.heading_deg = spec.field.heading_deg;
-        plant_params.boom = emulators::BoomGeometry{spec.boom.l1_m, spec.boom.l2_m, spec.boom.l3_m,
-                                                    spec.boom.linkage_rise_m};
-        const ScenarioPlan scenario = build_scenario(spec, plant_params.boom);
-        plant_params.route = scenario.route;
-        plant_params.start_nozzle_line_along_m = scenario.start_along_m;
-        plant_params.wheel.slip_pct = spec.encoder.slip_pct;
-        plant_params.wheel.slip_sd_pct = spec.encoder.slip_sd_pct;
-        plant_params.wheel.deflection_pct = spec.encoder.deflection_pct;
-        plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
-        plant_params.seed = result.seed;
-        const emulators::Plant plant(plant_params);
+        const CaseWorld world = build_case_world(spec, result.seed);
+        const emulators::Plant& plant = world.plant;
+        const ScenarioPlan& scenario = world.scenario;
         const bool static_test = spec.scenario == Scenario::static_flow;
-
-        const double crossing_s =
-            static_test ? std::numeric_limits<double>::quiet_NaN()
-                        : plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m,
-                                                                        scenario.approach_starts_s);
-        const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
+        const TimeNs end_ns = world.end_ns;
         // The deposition grid spans everything the boom can reach, with a margin.
         const double grid_from_m = std::min(scenario.start_along_m, spec.vehicle.start_m) - 5.0;
         const double grid_to_m = spec.breakpoint.along_m + spec.vehicle.overrun_m + 5.0;
@@ -457,7 +462,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
         // Nodes hold DDS writers, so they are declared after (and destroyed before) the context.
         emulators::PlantNode plant_node(plant, kVehicleTruthRateHz);
         emulators::SprayCircuitNode circuit_node(circuit, kHydraulicsTruthRateHz);
-        emulators::GnssG970 gnss(plant, gnss_params(spec, result.seed, crossing_s));
+        emulators::GnssG970 gnss(plant, world.gnss);
         emulators::WheelEncoder encoder(
             plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev, spec.encoder.wheel_diameter_m,
                                                  spec.encoder.rate_hz});

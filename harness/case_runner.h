@@ -8,6 +8,9 @@
 #include <ostream>
 #include <vector>
 
+#include "emulators/gnss_g970.h"
+#include "emulators/panel_switch.h"
+#include "emulators/plant.h"
 #include "harness/case_spec.h"
 #include "harness/html_report.h"
 #include "harness/results_writer.h"
@@ -21,6 +24,26 @@ struct RunOptions {
     // Default controller when a case names no command: the reference controller.
     std::filesystem::path controller_executable = "rig-controller";
 };
+
+// What the case's vehicle does and its operator presses (harness/case_runner.cpp).
+struct ScenarioPlan {
+    std::vector<emulators::RoutePhase> route;
+    double start_along_m = 0.0;  // nozzle line at t = 0
+    std::vector<emulators::SwitchClosure> button;
+    std::vector<emulators::SwitchClosure> spray_switch;
+    double approach_starts_s = 0.0;
+};
+
+// The case's world as `rig run` builds it: the plant, the operator's script and
+// the G970II's parameters. Bench tools (`rig emulate gnss`) use the same.
+struct CaseWorld {
+    emulators::Plant plant;
+    ScenarioPlan scenario;
+    emulators::G970Params gnss;
+    double breakpoint_crossing_s = 0.0;  // on the approach; NaN in a static test
+    TimeNs end_ns = 0;
+};
+CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed);
 
 // Checks that need more than the file itself (e.g. the reference controller's
 // own parameters); throws rig::ConfigError naming file, line and key.

@@ -3,6 +3,8 @@
 //   rig nmea decode FILE|-
 //   rig dds-check [--samples N] [--log-dir DIR]
 //   rig modbus serve [--tcp ADDRESS:PORT | --rtu DEVICE ...] [synthetic signal options]
+//   rig emulate gnss CASE [--port DEVICE | --pty] [--baud N]
+//   rig pty [...], rig hid list [...]
 #include <CLI/CLI.hpp>
 
 #include <fstream>
@@ -10,6 +12,7 @@
 #include <unistd.h>
 
 #include "controller/nmea_decode_tool.h"
+#include "harness/bench_emulate.h"
 #include "harness/bench_hid.h"
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
@@ -107,6 +110,7 @@ int main(int argc, char** argv) {
     // Bench wire adapters: `rig pty`, `rig hid list` (harness/bench_serial.h, harness/bench_hid.h).
     const rig::harness::PtyBenchCommand pty_bench(app);
     const rig::harness::HidBenchCommand hid_bench(app);
+    const rig::harness::EmulateBenchCommand emulate_bench(app);
 
     rig::DdsCheckOptions check_options;
     check_options.echo_executable = own_directory() / "rig";
@@ -128,6 +132,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     if (pty_bench.parsed()) return pty_bench.run();
     if (hid_bench.parsed()) return hid_bench.run();
+    if (emulate_bench.parsed()) return emulate_bench.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);

@@ -15,6 +15,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "controller/nmea_parser.h"
+#include "rig/child_process.h"
+#include "rig/serial_port.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -134,6 +138,41 @@ TEST(WholeRun, WiredControllerInRealTimePassesThePapersLimits) {
     for (const char* metric : {"flow_adjust_time_s", "flow_error_pct", "overlap_m", "missed_m", "breakpoint_error_m"}) {
         EXPECT_TRUE(result["metrics"].contains(metric)) << metric;
     }
+}
+
+// `rig emulate gnss`: a case's receiver onto a pseudo-terminal, read back by a
+// program that only speaks serial, decoded by the controller's parser.
+TEST(BenchEmulate, GnssStreamOfACaseGoesOutOnAPty) {
+    const fs::path dir = fresh_dir("emulate");
+    const fs::path link = dir / "gnss0";
+    rig::ChildProcess emulator({RIG_BINARY_DIR "/bin/rig", "emulate", "gnss",
+                                RIG_SOURCE_DIR "/cases/table3-fusion/table3-fusion-6kmh-s1.yaml", "--pty", "--link",
+                                link.string(), "--seconds", "6"},
+                               dir / "emulate.log");
+    for (int i = 0; i < 500 && !fs::exists(link); ++i) rig::RealtimeClock().sleep_until_ns(rig::seconds_to_ns(0.01));
+    ASSERT_TRUE(fs::exists(link)) << read_all(dir / "emulate.log");
+    rig::SerialPort port(link.string());
+    int gga = 0;
+    int rmc = 0;
+    for (int lines = 0; lines < 40 && (gga < 3 || rmc < 3); ++lines) {
+        const std::optional<std::string> line = port.read_line(std::chrono::milliseconds(3000));
+        ASSERT_TRUE(line.has_value()) << "no NMEA within 3 s; " << read_all(dir / "emulate.log");
+        const auto parsed = rig::nmea::parse_sentence(*line);
+        ASSERT_TRUE(parsed.ok()) << *line;
+        if (const auto* fix = std::get_if<rig::nmea::GgaData>(&parsed.sentence->data)) {
+            ++gga;
+            ASSERT_TRUE(fix->position.has_value()) << *line;
+            EXPECT_NEAR(fix->position->lat_deg, 40.18, 0.01) << *line;  // the case's field
+            EXPECT_NEAR(fix->position->lon_deg, 116.44, 0.01) << *line;
+            EXPECT_EQ(fix->fix_quality.value_or(0), 4) << *line;  // RTK fixed
+        } else if (std::holds_alternative<rig::nmea::RmcData>(parsed.sentence->data)) {
+            ++rmc;
+        }
+    }
+    EXPECT_GE(gga, 3);
+    EXPECT_GE(rmc, 3);
+    EXPECT_EQ(emulator.stop(std::chrono::milliseconds(15000)), "process exited with status 0")
+        << read_all(dir / "emulate.log");
 }
 
 }  // namespace
