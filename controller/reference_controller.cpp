@@ -21,9 +21,7 @@ void ReferenceController::configure(DdsContext& dds) {
     boom_height_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kBoomHeightSensor);
     button_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kBreakpointButton);
     spray_switch_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kSpraySwitch);
-    relays_writer_ = std::make_unique<Writer<msg::BallValveRelays>>(dds, topics::kBallValveRelays);
-    sections_writer_ = std::make_unique<Writer<msg::SectionValves>>(dds, topics::kSectionValves);
-    unloading_writer_ = std::make_unique<Writer<msg::UnloadingValve>>(dds, topics::kUnloadingValve);
+    actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     status_writer_ = std::make_unique<Writer<msg::ControllerStatus>>(dds, topics::kControllerStatus);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
 }
@@ -37,29 +35,6 @@ bool ReferenceController::has_unread_input() const {
     return nmea_reader_->has_unread() || encoder_reader_->has_unread() || flow_meter_reader_->has_unread() ||
            pump_sensor_reader_->has_unread() || boom_height_reader_->has_unread() || button_reader_->has_unread() ||
            spray_switch_reader_->has_unread();
-}
-
-void ReferenceController::publish_changed_actuators() {
-    const io::ActuatorCommands& now = firmware_.actuators();
-    const bool first = !published_;
-    if (first || now.ball_valve_forward != published_->ball_valve_forward ||
-        now.ball_valve_reverse != published_->ball_valve_reverse) {
-        msg::BallValveRelays relays;
-        relays.forward(now.ball_valve_forward);
-        relays.reverse(now.ball_valve_reverse);
-        relays_writer_->publish(relays);
-    }
-    if (first || now.section_valves_open != published_->section_valves_open) {
-        msg::SectionValves sections;
-        sections.open_mask(now.section_valves_open);
-        sections_writer_->publish(sections);
-    }
-    if (first || now.unloading_valve_open != published_->unloading_valve_open) {
-        msg::UnloadingValve unloading;
-        unloading.open(now.unloading_valve_open);
-        unloading_writer_->publish(unloading);
-    }
-    published_ = now;
 }
 
 TimeNs ReferenceController::step(TimeNs now_ns) {
@@ -76,7 +51,7 @@ TimeNs ReferenceController::step(TimeNs now_ns) {
     for (const auto& sample : spray_switch_reader_->take_all()) firmware_.on_spray_switch(sample.closed(), now_ns);
 
     TimeNs next_wake = firmware_.update(now_ns);
-    publish_changed_actuators();
+    actuators_writer_->publish_changes(firmware_.actuators());
     for (const msg::BreakpointEvent& event : firmware_.take_events()) event_writer_->publish(event);
     for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
     if (now_ns >= next_status_ns_) {

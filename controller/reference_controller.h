@@ -19,6 +19,7 @@
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
+#include "rig/actuator_topics.h"
 #include "rig/dds_context.h"
 #include "rig/node.h"
 
@@ -34,8 +35,6 @@ public:
     bool has_unread_input() const override;
 
 private:
-    void publish_changed_actuators();
-
     // --- subscriptions
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
     std::unique_ptr<Reader<msg::EncoderCount>> encoder_reader_;
@@ -45,16 +44,13 @@ private:
     std::unique_ptr<Reader<msg::SwitchLevel>> button_reader_;
     std::unique_ptr<Reader<msg::SwitchLevel>> spray_switch_reader_;
     // --- publications
-    std::unique_ptr<Writer<msg::BallValveRelays>> relays_writer_;
-    std::unique_ptr<Writer<msg::SectionValves>> sections_writer_;
-    std::unique_ptr<Writer<msg::UnloadingValve>> unloading_writer_;
+    std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::ControllerStatus>> status_writer_;
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
 
     std::string name_;
     ControllerConfig config_;
     SprayController firmware_;
-    std::optional<io::ActuatorCommands> published_;  // what the actuator topics last said
     TimeNs status_period_ns_;
     TimeNs next_status_ns_ = 0;
 };

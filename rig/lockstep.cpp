@@ -351,7 +351,8 @@ std::optional<msg::ClockTick> FollowerLink::next_tick(std::chrono::milliseconds 
 
 bool FollowerLink::harness_present() const { return tick_reader_->matched_writers() > 0; }
 
-int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options) {
+std::variant<std::unique_ptr<FollowerLink>, int> start_follower(Node& node, DdsContext& dds,
+                                                               const FollowerOptions& options) {
     std::unique_ptr<FollowerLink> link;
     try {
         link = std::make_unique<FollowerLink>(dds, options);
@@ -361,6 +362,13 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
         return 2;
     }
     if (!link->wait_matched()) return 3;
+    return link;
+}
+
+int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const FollowerOptions& options) {
+    auto started = start_follower(node, dds, options);
+    if (const int* exit_code = std::get_if<int>(&started)) return *exit_code;
+    const std::unique_ptr<FollowerLink> link = std::move(std::get<std::unique_ptr<FollowerLink>>(started));
 
     bool activated = false;
     WallStopwatch idle;

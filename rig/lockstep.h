@@ -32,6 +32,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "rig/clock.h"
@@ -157,6 +158,12 @@ private:
     std::unique_ptr<Writer<msg::ClockAck>> ack_writer_;
     std::deque<msg::ClockTick> pending_;
 };
+
+// The start both followers share: the clock endpoints, the node's configure(),
+// every endpoint matched. Returns the link, or the process exit code with the
+// reason already on stderr (2: configure failed, 3: no counterpart in time).
+std::variant<std::unique_ptr<FollowerLink>, int> start_follower(Node& node, DdsContext& dds,
+                                                               const FollowerOptions& options);
 
 // Follower side: runs `node` in this process under the master's ticks until the
 // shutdown tick. Returns a process exit code (0 = clean shutdown) and prints the

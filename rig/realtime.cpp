@@ -128,15 +128,9 @@ std::map<std::string, JitterStats> RealtimeMaster::emission_jitter() const {
 }
 
 int run_realtime_follower(Node& node, DdsContext& dds, const FollowerOptions& options) {
-    std::unique_ptr<FollowerLink> link;
-    try {
-        link = std::make_unique<FollowerLink>(dds, options);
-        node.configure(dds);
-    } catch (const std::exception& error) {
-        std::cerr << options.node_name << ": configure failed: " << error.what() << "\n";
-        return 2;
-    }
-    if (!link->wait_matched()) return 3;
+    auto started = start_follower(node, dds, options);
+    if (const int* exit_code = std::get_if<int>(&started)) return *exit_code;
+    const std::unique_ptr<FollowerLink> link = std::move(std::get<std::unique_ptr<FollowerLink>>(started));
 
     // Until the start tick, only hellos are answered.
     const WallStopwatch waiting;

@@ -101,9 +101,7 @@ void BoardIoAdapter::configure(DdsContext& dds) {
     boom_height_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kBoomHeightSensor);
     button_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kBreakpointButton);
     spray_switch_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kSpraySwitch);
-    relays_writer_ = std::make_unique<Writer<msg::BallValveRelays>>(dds, topics::kBallValveRelays);
-    sections_writer_ = std::make_unique<Writer<msg::SectionValves>>(dds, topics::kSectionValves);
-    unloading_writer_ = std::make_unique<Writer<msg::UnloadingValve>>(dds, topics::kUnloadingValve);
+    actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
 }
 
@@ -129,26 +127,7 @@ void BoardIoAdapter::take_device_topics() {
 }
 
 void BoardIoAdapter::publish_outputs(TimeNs now_ns) {
-    const io::ActuatorCommands outputs = wire_.outputs();
-    const bool first = !published_;
-    if (first || outputs.ball_valve_forward != published_->ball_valve_forward ||
-        outputs.ball_valve_reverse != published_->ball_valve_reverse) {
-        msg::BallValveRelays relays;
-        relays.forward(outputs.ball_valve_forward);
-        relays.reverse(outputs.ball_valve_reverse);
-        relays_writer_->publish(relays);
-    }
-    if (first || outputs.section_valves_open != published_->section_valves_open) {
-        msg::SectionValves sections;
-        sections.open_mask(outputs.section_valves_open);
-        sections_writer_->publish(sections);
-    }
-    if (first || outputs.unloading_valve_open != published_->unloading_valve_open) {
-        msg::UnloadingValve unloading;
-        unloading.open(outputs.unloading_valve_open);
-        unloading_writer_->publish(unloading);
-    }
-    published_ = outputs;
+    actuators_writer_->publish_changes(wire_.outputs());
 
     // The board's breakpoint counters become events (its claims; position unknown on this wire).
     const io::ControllerIndicators indicators = wire_.indicators();

@@ -21,6 +21,7 @@
 #include <optional>
 #include <string>
 
+#include "rig/actuator_topics.h"
 #include "rig/dds_context.h"
 #include "rig/hid_board.h"
 #include "rig/io_image.h"
@@ -132,7 +133,6 @@ private:
     TimeNs period_ns_;
     TimeNs next_update_ns_ = 0;
     io::DeviceSignals signals_{};
-    std::optional<io::ActuatorCommands> published_;
     io::ControllerIndicators seen_indicators_{};
     // --- subscriptions
     std::unique_ptr<Reader<msg::EncoderCount>> encoder_reader_;
@@ -142,9 +142,7 @@ private:
     std::unique_ptr<Reader<msg::SwitchLevel>> button_reader_;
     std::unique_ptr<Reader<msg::SwitchLevel>> spray_switch_reader_;
     // --- publications
-    std::unique_ptr<Writer<msg::BallValveRelays>> relays_writer_;
-    std::unique_ptr<Writer<msg::SectionValves>> sections_writer_;
-    std::unique_ptr<Writer<msg::UnloadingValve>> unloading_writer_;
+    std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
 };
 

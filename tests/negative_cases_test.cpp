@@ -3,6 +3,8 @@
 // exactly those metrics break their limits, and the same case without its
 // expectation fails the run. Each run takes a few seconds of wall time.
 #include <gtest/gtest.h>
+
+#include "run_support.h"
 #include <unistd.h>
 #include <sys/wait.h>
 
@@ -25,18 +27,10 @@ namespace fs = std::filesystem;
 const fs::path kNegativeDir = fs::path(RIG_SOURCE_DIR) / "cases" / "negative";
 
 fs::path fresh_dir(const std::string& name) {
-    const fs::path dir = fs::path(::testing::TempDir()) / ("negative-cases-" + std::to_string(::getpid()) + "-" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
+    return rig::testing::fresh_dir("negative-cases-" + std::to_string(::getpid()) + "-" + name);
 }
 
-std::string read_all(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
+using rig::testing::read_all;
 
 // Runs `rig run TARGET --out OUT`; returns the exit status (-1 if it did not exit normally).
 int rig_run(const fs::path& target, const fs::path& out, const fs::path& log) {

@@ -7,6 +7,8 @@
 //    too slow to finish under ptrace.
 #include <gtest/gtest.h>
 
+#include "run_support.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,19 +21,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_dir(const std::string& name) {
-    const fs::path dir = fs::path(::testing::TempDir()) / ("network-loopback-" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path fresh_dir(const std::string& name) { return rig::testing::fresh_dir("network-loopback-" + name); }
 
-std::string read_all(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
+using rig::testing::read_all;
 
 // Destinations in an strace log (sendto/sendmsg/connect lines as strace 6 prints them).
 std::set<std::string> strace_destinations(const fs::path& strace_log) {

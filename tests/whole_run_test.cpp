@@ -6,6 +6,8 @@
 //    Modbus RTU on a pty pair) passes the paper's limits and reports its jitter.
 #include <gtest/gtest.h>
 
+#include "run_support.h"
+
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -23,19 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_dir(const std::string& name) {
-    const fs::path dir = fs::path(::testing::TempDir()) / ("whole-run-" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path fresh_dir(const std::string& name) { return rig::testing::fresh_dir("whole-run-" + name); }
 
-std::string read_all(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
+using rig::testing::read_all;
 
 struct RunOutcome {
     int exit_code = -1;

@@ -1,0 +1,29 @@
+#pragma once
+// Small helpers for the tests that run the `rig` executables as a user would
+// (whole runs, the network check, the negative cases).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace rig::testing {
+
+// An empty scratch folder under GoogleTest's temp dir, named for the test.
+inline std::filesystem::path fresh_dir(const std::string& name) {
+    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+// A whole file as text ("" when it cannot be read: the caller's assertion says what was expected).
+inline std::string read_all(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+}  // namespace rig::testing
