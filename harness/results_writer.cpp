@@ -513,6 +513,17 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
             }
         }
         for (const std::string& failure : result.failures) report += "failure: " + failure + "\n";
+        if (result.mode == "realtime") {
+            report += "real time: " + result.realtime_scheduling + "\nwiring: " + result.wiring + "\n";
+            report += "emission jitter (ms)      p50      p99      max  samples\n";
+            for (const EmissionJitter& device : result.emission_jitter) {
+                if (device.samples == 0) continue;
+                char line[160];
+                std::snprintf(line, sizeof line, "  %-20s %8.3f %8.3f %8.3f %8zu\n", device.device.c_str(),
+                              device.p50_ms, device.p99_ms, device.max_ms, device.samples);
+                report += line;
+            }
+        }
     }
     return report;
 }
