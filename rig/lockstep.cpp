@@ -81,7 +81,7 @@ LockstepMaster::~LockstepMaster() { shutdown(); }
 void LockstepMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0}); }
 
 void LockstepMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
-    remotes_.push_back(Remote{name, std::move(liveness), 0, {}, {}});
+    remotes_.push_back(Remote{name, std::move(liveness), 0, {}, {}, {}});
 }
 
 void LockstepMaster::start() {
@@ -128,6 +128,23 @@ void LockstepMaster::start() {
             ack_reader_->wait_for_data(std::chrono::milliseconds(5));
         }
     }
+    // And every local reader must be reached by every writer of its topic: ours
+    // (checked above from the writer's side) and the remotes' (from here: a
+    // remote only knows that one reader matched its writer, not that all did).
+    for (ReaderBase* reader : dds_.readers()) {
+        if (reader == ack_reader_.get()) continue;
+        int expected = 0;
+        for (WriterBase* writer : dds_.writers()) expected += writer->topic_name() == reader->topic_name();
+        for (const Remote& remote : remotes_) {
+            expected += static_cast<int>(std::count(remote.published_topics.begin(), remote.published_topics.end(),
+                                                    reader->topic_name()));
+        }
+        while (reader->matched_writers() < expected) {
+            check_startup("matching of topic " + reader->topic_name() + " (" +
+                          std::to_string(reader->matched_writers()) + "/" + std::to_string(expected) + " writers)");
+            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+        }
+    }
     for (Local& local : locals_) local.node->activate(0);
     started_ = true;
 }
@@ -138,6 +155,17 @@ LockstepMaster::TopicCounts LockstepMaster::all_published_counts() const {
         for (const auto& [topic, samples] : remote.published_counts) totals[topic] += samples;
     }
     return totals;
+}
+
+LockstepMaster::TopicCounts LockstepMaster::reader_counts() const {
+    TopicCounts counts;
+    for (ReaderBase* reader : dds_.readers()) {
+        if (reader != ack_reader_.get()) ++counts[reader->topic_name()];
+    }
+    for (const Remote& remote : remotes_) {
+        for (const std::string& topic : remote.subscribed_topics) ++counts[topic];
+    }
+    return counts;
 }
 
 void LockstepMaster::check_remotes_alive(TimeNs t) const {
@@ -176,6 +204,7 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
     tick.time_ns(t);
     tick.shutdown(shutdown);
     fill_counts(all_published_counts(), tick.published_counts());
+    if (seq_ == 1) fill_counts(reader_counts(), tick.reader_counts());
     const std::uint64_t seq = seq_++;
     tick_writer_->publish(tick);
 
@@ -197,7 +226,10 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
                 remotes_[i].next_wake_ns = ack.next_wake_ns();
                 remotes_[i].published_counts = read_counts(ack.published_counts());
                 published += ack.published_count();
-                if (hello) remotes_[i].subscribed_topics = split_topics(ack.subscribed_topics().to_string());
+                if (hello) {
+                    remotes_[i].subscribed_topics = split_topics(ack.subscribed_topics().to_string());
+                    remotes_[i].published_topics = split_topics(ack.published_topics().to_string());
+                }
             }
         }
         if (outstanding == 0) break;
@@ -311,6 +343,22 @@ bool FollowerLink::wait_matched() {
     }
 }
 
+namespace {
+
+// The hello's topic lists are bounded strings (idl/clock.idl); a longer list
+// would be cut and the harness would wait for the wrong endpoints.
+const std::string& checked_topic_list(const std::string& list, const char* what) {
+    constexpr std::size_t kMaxTopicListLength = 1024;
+    if (list.size() > kMaxTopicListLength) {
+        throw std::length_error(std::string("lockstep hello: the ") + what + " topic list is " +
+                                std::to_string(list.size()) + " characters, more than the clock's " +
+                                std::to_string(kMaxTopicListLength) + " (idl/clock.idl)");
+    }
+    return list;
+}
+
+}  // namespace
+
 void FollowerLink::ack(std::uint64_t seq, TimeNs next_wake, std::uint32_t published, const std::string& subscribed,
                        const std::string& fatal) {
     msg::ClockAck ack;
@@ -319,8 +367,16 @@ void FollowerLink::ack(std::uint64_t seq, TimeNs next_wake, std::uint32_t publis
     ack.next_wake_ns(next_wake);
     ack.published_count(published);
     fill_counts(dds_.written_counts(), ack.published_counts());
-    ack.subscribed_topics(subscribed);
-    ack.fatal_error(fatal.substr(0, 1000));
+    ack.subscribed_topics(checked_topic_list(subscribed, "subscribed"));
+    if (seq == 0) {
+        std::string written_topics;
+        for (WriterBase* writer : dds_.writers()) {
+            if (writer == ack_writer_.get()) continue;
+            written_topics += (written_topics.empty() ? "" : ",") + writer->topic_name();
+        }
+        ack.published_topics(checked_topic_list(written_topics, "published"));
+    }
+    ack.fatal_error(fatal.substr(0, 500));
     ack_writer_->publish(ack);
 }
 
@@ -350,6 +406,28 @@ std::optional<msg::ClockTick> FollowerLink::next_tick(std::chrono::milliseconds 
 }
 
 bool FollowerLink::harness_present() const { return tick_reader_->matched_writers() > 0; }
+
+std::string FollowerLink::wait_writers_reach_readers(const msg::ClockTick& first_tick) {
+    const TopicCounts readers = read_counts(first_tick.reader_counts());
+    const WallStopwatch waited;
+    for (;;) {
+        std::vector<std::string> short_topics;
+        for (WriterBase* writer : dds_.writers()) {
+            const auto it = readers.find(writer->topic_name());
+            if (it == readers.end() || writer == ack_writer_.get()) continue;
+            if (static_cast<std::uint64_t>(writer->matched_readers()) < it->second) {
+                short_topics.push_back(writer->topic_name() + " (" + std::to_string(writer->matched_readers()) + "/" +
+                                       std::to_string(it->second) + " readers)");
+            }
+        }
+        if (short_topics.empty()) return {};
+        if (waited.elapsed() > options_.startup_timeout) {
+            return "writers did not reach every reader within " + std::to_string(options_.startup_timeout.count()) +
+                   " ms: " + join(short_topics);
+        }
+        tick_reader_->wait_for_data(std::chrono::milliseconds(5));
+    }
+}
 
 std::variant<std::unique_ptr<FollowerLink>, int> start_follower(Node& node, DdsContext& dds,
                                                                const FollowerOptions& options) {
@@ -407,6 +485,13 @@ int run_lockstep_follower(Node& node, DdsContext& dds, ManualClock& clock, const
         }
         dds.take_published_count();
         TimeNs next_wake = kNever;
+        if (!activated) {
+            if (const std::string problem = link->wait_writers_reach_readers(*tick); !problem.empty()) {
+                link->final_ack(tick->seq(), problem);
+                std::cerr << options.node_name << ": " << problem << "\n";
+                return 3;
+            }
+        }
         try {
             if (!activated) {
                 node.activate(tick->time_ns());

@@ -20,8 +20,14 @@
 //            seen by its readers at t; delays come only from the models.
 // Then the master jumps to the earliest next_wake of all nodes: idle simulated
 // time costs nothing. Tick 0 is a hello: the remote answers once all its
-// endpoints are matched, listing the topics it reads so the master can wait for
-// its own writers to reach them. A remote that does not answer within the
+// endpoints are matched, listing the topics it reads and writes; the master then
+// waits until each of its writers reaches every reader of its topic and each of
+// its readers is reached by every writer. The first tick after the hello carries
+// how many readers each topic has, and a remote's writers must reach all of them
+// before it first publishes: discovery matches the two ends of a pair at
+// different moments, and a volatile sample written to a writer that does not
+// know a reader yet never reaches that reader (seen as a case stuck at t = 0
+// waiting for the controller's first actuator samples, about 1 run in 50). A remote that does not answer within the
 // wall-time bound, or whose process ends, fails the run with its name.
 #include <chrono>
 #include <deque>
@@ -96,6 +102,7 @@ private:
         std::function<std::optional<std::string>()> liveness;
         TimeNs next_wake_ns = 0;
         std::vector<std::string> subscribed_topics;
+        std::vector<std::string> published_topics;
         TopicCounts published_counts;  // cumulative, from its latest ack
     };
     struct Local {
@@ -106,6 +113,8 @@ private:
     std::uint32_t tick_remotes(TimeNs t, bool shutdown);
     // What every process has published so far, per topic.
     TopicCounts all_published_counts() const;
+    // How many readers each topic has, here and in the remotes.
+    TopicCounts reader_counts() const;
     // Until the local readers hold all of it (bounded; a dead remote is named).
     void wait_local_readers(TimeNs t);
 
@@ -150,6 +159,9 @@ public:
     void final_ack(std::uint64_t seq, const std::string& fatal);
     // The harness's clock writer is still matched (it goes away when the harness dies).
     bool harness_present() const;
+    // Before the first step: until every writer here reaches the readers the
+    // first tick counted for its topic. Returns why not (empty = all reached).
+    std::string wait_writers_reach_readers(const msg::ClockTick& first_tick);
 
 private:
     DdsContext& dds_;

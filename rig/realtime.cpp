@@ -146,6 +146,11 @@ int run_realtime_follower(Node& node, DdsContext& dds, const FollowerOptions& op
         link->final_ack(start->seq(), "");
         return 0;
     }
+    if (const std::string problem = link->wait_writers_reach_readers(*start); !problem.empty()) {
+        link->final_ack(start->seq(), problem);
+        std::cerr << options.node_name << ": " << problem << "\n";
+        return 3;
+    }
     RealtimeClock clock;
     TimeNs next_wake = 0;
     try {
