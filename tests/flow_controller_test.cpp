@@ -358,10 +358,11 @@ std::filesystem::path fresh_state_dir(const std::string& name) {
     return dir;
 }
 
-rig::emulators::SprayCircuitParams bench_circuit() {
-    rig::emulators::SprayCircuitParams params;  // pulsating pump, drift 1.5 %, bulge 3 %, as in the cases
+rig::emulators::SprayCircuitParams bench_circuit(double calibration_drift_pct = 1.0) {
+    rig::emulators::SprayCircuitParams params;  // pulsating pump, drift 1 %, bulge 2 %, as in the cases
     params.pump_flow_l_min = 31.1;
     params.valve.initial_opening_pct = 85.0;   // as in cases/: 5 s forward reaches the end stop from there
+    params.flow_map.calibration_drift_pct = calibration_drift_pct;
     return params;
 }
 
@@ -372,9 +373,9 @@ rig::emulators::SprayCircuitParams bench_circuit() {
 class Bench {
 public:
     Bench(ControllerConfig config, const std::filesystem::path& state_dir,
-          std::vector<rig::emulators::RoutePhase> route)
+          std::vector<rig::emulators::RoutePhase> route, double calibration_drift_pct = 1.0)
         : plant_(plant_params(std::move(route))),
-          circuit_(plant_, bench_circuit()),
+          circuit_(plant_, bench_circuit(calibration_drift_pct)),
           pump_sensor_(circuit_, pump_sensor_params()),
           config_(config),
           controller_(std::move(config), state_dir) {}
@@ -584,6 +585,33 @@ TEST(SprayController, ResetsThenPreAdjustsThenRegulatesToTarget) {
     // Valve belief and truth still agree after the PID's trims (same model, 1 ms relay grid).
     EXPECT_NEAR(bench.controller().status(bench.now()).valve_opening_estimate_pct(),
                 bench.circuit().valve_opening_pct(), 0.1);
+}
+
+// A valve 5 % off its calibration: pre-adjustment alone leaves the flow outside
+// the band, and the PID has to bring it in, with Eq. 2's output in either unit.
+void expect_pid_closes_a_calibration_gap(rig::controller::PidOutput output, const char* state) {
+    ControllerConfig config = static_config();
+    config.pid_output = output;
+    Bench bench(config, fresh_state_dir(state), standing(), /*calibration_drift_pct=*/5.0);
+    bench.set_spray_switch(true);
+    bench.start();
+    bench.run_until(9500 * kMs);  // reset, pre-adjust, sections open, the pipeline fills
+    ASSERT_EQ(bench.controller().phase(), rig::msg::SPRAY_REGULATING);
+    const double pre_adjusted_flow = bench.circuit().main_flow_l_min();
+    const double pre_adjusted_opening = bench.circuit().valve_opening_pct();
+    EXPECT_GT(pre_adjusted_flow, 20.0 * 1.03) << "the gap must be outside the band for the PID to matter";
+    bench.run_until(20 * kS);
+    EXPECT_NEAR(bench.circuit().main_flow_l_min(), 20.0, 20.0 * 0.03);
+    // It got there by closing the valve (the plant gives 5 % more than calibrated).
+    EXPECT_LT(bench.circuit().valve_opening_pct(), pre_adjusted_opening - 0.2);
+}
+
+TEST(SprayController, PidClosesACalibrationGapWithFlowOutput) {
+    expect_pid_closes_a_calibration_gap(rig::controller::PidOutput::flow_l_min, "pid-flow");
+}
+
+TEST(SprayController, PidClosesACalibrationGapWithOpeningOutput) {
+    expect_pid_closes_a_calibration_gap(rig::controller::PidOutput::opening_pct, "pid-opening");
 }
 
 TEST(SprayController, SwitchOnFromPowerOnGoesThroughIdleToPreAdjust) {
