@@ -542,9 +542,12 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
                 throw std::runtime_error(std::string(failure.what()) + log_tail(controller_log));
             }
             for (const auto& [device, stats] : master.emission_jitter()) {
+                // Nodes that only react to inputs (the NMEA serial adapter, a switch
+                // never toggled) had no deadline to be late for: nothing to report.
+                if (stats.samples == 0) continue;
                 result.emission_jitter.push_back(EmissionJitter{device, stats.samples, stats.p50_ms, stats.p99_ms,
-                                                                stats.max_ms});
-                figures.jitter.push_back(JitterRow{device, stats.p50_ms, stats.p99_ms, stats.max_ms});
+                                                                stats.max_ms, stats.step_p99_ms, stats.step_max_ms});
+                figures.jitter.push_back(JitterRow{device, stats.p50_ms, stats.p99_ms, stats.max_ms, stats.step_max_ms});
             }
         }
         circuit.advance_to(end_ns);

@@ -1047,11 +1047,12 @@ std::string area_table(const CaseFigures& figures) {
 
 std::string jitter_table(const std::vector<JitterRow>& jitter) {
     std::string table = "<table class=\"jitter\">\n<tr><th>device</th><th>p50 (ms)</th><th>p99 (ms)</th>"
-                        "<th>max (ms)</th></tr>\n";
+                        "<th>max (ms)</th><th>slowest own step (ms)</th></tr>\n";
     for (const JitterRow& row : jitter) {
         table += "<tr><td>" + html(row.device) + "</td><td class=\"num\">" + fixed_number(row.p50_ms, 3) +
                  "</td><td class=\"num\">" + fixed_number(row.p99_ms, 3) + "</td><td class=\"num\">" +
-                 fixed_number(row.max_ms, 3) + "</td></tr>\n";
+                 fixed_number(row.max_ms, 3) + "</td><td class=\"num\">" + fixed_number(row.step_max_ms, 3) +
+                 "</td></tr>\n";
     }
     return table + "</table>\n";
 }

@@ -43,6 +43,7 @@ struct JitterRow {
     double p50_ms = kNotMeasured;
     double p99_ms = kNotMeasured;
     double max_ms = kNotMeasured;
+    double step_max_ms = kNotMeasured;  // its own slowest update
 };
 
 // What one case recorded for its figures; a figure is drawn only when it has data.

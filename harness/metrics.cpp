@@ -162,8 +162,15 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
         result.metrics["repeated_from_m"] = repeated_from_m - breakpoint_along_m;
         result.metrics["repeated_to_m"] = repeated_to_m - breakpoint_along_m;
     }
-    const double operational_from_m = repeated_from_m - judging.cv_window_m;
-    const double continuation_to_m = repeated_to_m + judging.cv_window_m;
+    // The operational and continuation areas reach cv_window_m either side, but
+    // never past the first or last sprayed row: a case that ends its pass inside
+    // the window would otherwise count bare ground as uneven deposition.
+    double operational_from_m = repeated_from_m - judging.cv_window_m;
+    double continuation_to_m = repeated_to_m + judging.cv_window_m;
+    if (first_sprayed) {
+        operational_from_m = std::max(operational_from_m, profile.row_centre_m(*first_sprayed) - 0.5 * profile.row_m);
+        continuation_to_m = std::min(continuation_to_m, profile.row_centre_m(*last_sprayed) + 0.5 * profile.row_m);
+    }
     result.areas.insert(result.areas.begin(), {"operational", operational_from_m, repeated_from_m});
     result.areas.push_back({"continuation", repeated_to_m, continuation_to_m});
     const auto cv = [&](double from_m, double to_m) {

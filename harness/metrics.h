@@ -89,7 +89,8 @@ struct DepositionResult {
 // the first and the last sprayed row sprayed by neither. cv_*_pct: Eq. 10-12 over
 // the operational area (first pass only, up to cv_window_m before the repeated
 // one), the repeated area, and the continuation area (second pass only, cv_window_m
-// after it); repeated_from_m / repeated_to_m relative to the breakpoint.
+// after it), the outer two cut at the first and last sprayed row;
+// repeated_from_m / repeated_to_m relative to the breakpoint.
 DepositionResult deposition_metrics(const DoseProfile& profile, const DepositionJudging& judging,
                                     double breakpoint_along_m);
 

@@ -384,7 +384,9 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
                 jitter[valid_utf8(device.device)] = {{"samples", device.samples},
                                                       {"p50_ms", device.p50_ms},
                                                       {"p99_ms", device.p99_ms},
-                                                      {"max_ms", device.max_ms}};
+                                                      {"max_ms", device.max_ms},
+                                                      {"step_p99_ms", device.step_p99_ms},
+                                                      {"step_max_ms", device.step_max_ms}};
             }
             one_case["realtime"] = {{"scheduling", valid_utf8(result.realtime_scheduling)},
                                     {"wiring", valid_utf8(result.wiring)},
@@ -515,12 +517,13 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
         for (const std::string& failure : result.failures) report += "failure: " + failure + "\n";
         if (result.mode == "realtime") {
             report += "real time: " + result.realtime_scheduling + "\nwiring: " + result.wiring + "\n";
-            report += "emission jitter (ms)      p50      p99      max  samples\n";
+            report += "emission jitter (ms)      p50      p99      max  samples   step p99  step max\n";
             for (const EmissionJitter& device : result.emission_jitter) {
                 if (device.samples == 0) continue;
                 char line[160];
-                std::snprintf(line, sizeof line, "  %-20s %8.3f %8.3f %8.3f %8zu\n", device.device.c_str(),
-                              device.p50_ms, device.p99_ms, device.max_ms, device.samples);
+                std::snprintf(line, sizeof line, "  %-20s %8.3f %8.3f %8.3f %8zu %10.3f %9.3f\n",
+                              device.device.c_str(), device.p50_ms, device.p99_ms, device.max_ms, device.samples,
+                              device.step_p99_ms, device.step_max_ms);
                 report += line;
             }
         }

@@ -19,6 +19,8 @@ struct EmissionJitter {
     double p50_ms = 0.0;
     double p99_ms = 0.0;
     double max_ms = 0.0;
+    double step_p99_ms = 0.0;   // the device's own step (update) durations
+    double step_max_ms = 0.0;
 };
 
 struct CaseResult {

@@ -58,7 +58,7 @@ RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds
 
 RealtimeMaster::~RealtimeMaster() { shutdown(); }
 
-void RealtimeMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0, {}}); }
+void RealtimeMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0, {}, {}}); }
 
 void RealtimeMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
     remotes_.add_remote_node(name, std::move(liveness));
@@ -87,8 +87,10 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
                 // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
                 if (local.next_wake_ns > 0) local.late_ns.push_back(now - local.next_wake_ns);
                 local.next_wake_ns = local.node->step(now);
+                local.step_ns.push_back(clock_.now_ns() - now);
             } else if (local.node->has_unread_input()) {
                 local.next_wake_ns = std::min(local.next_wake_ns, local.node->step(now));
+                local.step_ns.push_back(clock_.now_ns() - now);
             }
         }
         if (after_step_) after_step_(now);
@@ -123,7 +125,13 @@ void RealtimeMaster::shutdown() noexcept {
 
 std::map<std::string, JitterStats> RealtimeMaster::emission_jitter() const {
     std::map<std::string, JitterStats> jitter;
-    for (const Local& local : locals_) jitter[local.node->name()] = summarize_lateness(local.late_ns);
+    for (const Local& local : locals_) {
+        JitterStats stats = summarize_lateness(local.late_ns);
+        const JitterStats steps = summarize_lateness(local.step_ns);
+        stats.step_p99_ms = steps.p99_ms;
+        stats.step_max_ms = steps.max_ms;
+        jitter[local.node->name()] = stats;
+    }
     return jitter;
 }
 

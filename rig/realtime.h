@@ -36,6 +36,10 @@ struct JitterStats {
     double p50_ms = 0.0;
     double p99_ms = 0.0;
     double max_ms = 0.0;
+    // How long the node's own steps took: a long step makes every node after
+    // it in the loop late, so this says whose update a lateness came from.
+    double step_p99_ms = 0.0;
+    double step_max_ms = 0.0;
 };
 // Nearest-rank percentiles of `late_ns` (all >= 0); zeros when empty.
 JitterStats summarize_lateness(std::vector<TimeNs> late_ns);
@@ -82,6 +86,7 @@ private:
         Node* node;
         TimeNs next_wake_ns = 0;
         std::vector<TimeNs> late_ns;
+        std::vector<TimeNs> step_ns;
     };
     DdsContext& dds_;
     LockstepMaster remotes_;

@@ -218,7 +218,7 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     EXPECT_DOUBLE_EQ(spec.timeouts.case_wall_s, 600.0);
     // An identification case measures only the breakpoint error of the defaults.
     EXPECT_EQ(spec.scenario, Scenario::breakpoint_identification);
-    EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"breakpoint_error_m", 0.16}}));
+    EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"breakpoint_error_m", 0.20}}));
 }
 
 TEST(CaseSpec, DefaultLimitsFollowWhatTheScenarioMeasures) {

@@ -243,6 +243,23 @@ TEST(DepositionMetrics, ContinuationCvByHand) {
     EXPECT_NEAR(at(result.metrics, "cv_operational_pct"), 0.0, 1e-9);
 }
 
+TEST(DepositionMetrics, CvAreasStopWhereTheSprayingStops) {
+    // The first pass starts 3 m before the breakpoint and the continuation stops
+    // 2 m after it, both inside the 6 m windows: the areas end at the sprayed
+    // rows, so the bare ground beyond does not count as uneven deposition.
+    const auto p = profile([](int i) { return i >= 140 && i < 200 ? kNominal : 0.0; },
+                           [](int i) { return i >= 200 && i < 240 ? kNominal : 0.0; });
+    const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
+    const AreaSpan* operational = find_area(result.areas, "operational");
+    const AreaSpan* continuation = find_area(result.areas, "continuation");
+    ASSERT_NE(operational, nullptr);
+    ASSERT_NE(continuation, nullptr);
+    EXPECT_NEAR(operational->from_along_m, -3.0, 1e-9);
+    EXPECT_NEAR(continuation->to_along_m, 2.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics, "cv_operational_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics, "cv_continuation_pct"), 0.0, 1e-9);
+}
+
 // ---------------------------------------------------------------- Eq. 10-12
 
 TEST(CoefficientOfVariation, Eq10To12ByHand) {

@@ -89,8 +89,9 @@ TEST(NegativeCases, SuitePassesWhenExactlyTheExpectedMetricsBreak) {
     EXPECT_EQ(failing_metrics(*gains_x5), (std::set<std::string>{"flow_adjust_time_s"})) << gains_x5->dump(2);
     EXPECT_GT(gains_x5->at("metrics").at("flow_adjust_time_s").get<double>(),
               gains_x5->at("limits").at("flow_adjust_time_s").get<double>());
-    // Not a near miss: it swings for seconds (the paper gains settle in about 1 s).
-    EXPECT_GT(gains_x5->at("metrics").at("flow_adjust_time_s").get<double>(), 5.0);
+    // Not a near miss: it swings for seconds, more than twice the 1.3 s the
+    // paper's gains take on the same plant (continuation-6kmh).
+    EXPECT_GT(gains_x5->at("metrics").at("flow_adjust_time_s").get<double>(), 2.6);
 }
 
 TEST(NegativeCases, NoCompensationWithoutItsExpectationFailsTheRun) {
