@@ -86,11 +86,13 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
             if (local.next_wake_ns <= now) {
                 // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
                 if (local.next_wake_ns > 0) local.late_ns.push_back(now - local.next_wake_ns);
+                const TimeNs step_started_ns = clock_.now_ns();
                 local.next_wake_ns = local.node->step(now);
-                local.step_ns.push_back(clock_.now_ns() - now);
+                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
             } else if (local.node->has_unread_input()) {
+                const TimeNs step_started_ns = clock_.now_ns();
                 local.next_wake_ns = std::min(local.next_wake_ns, local.node->step(now));
-                local.step_ns.push_back(clock_.now_ns() - now);
+                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
             }
         }
         if (after_step_) after_step_(now);
