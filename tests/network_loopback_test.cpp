@@ -53,7 +53,10 @@ std::set<std::string> recorder_destinations(const fs::path& recorder_log) {
 }
 
 std::string preload(const fs::path& recorder_log) {
-    return "env ASAN_OPTIONS=verify_asan_link_order=0 LD_PRELOAD='" RIG_SEND_RECORDER "' RIG_SEND_LOG='" + recorder_log.string() + "' ";
+    // Adds to ASAN_OPTIONS rather than replacing it: a sanitizer build's test
+    // environment masks a mismatch inside Fast DDS there (cmake/RigHelpers.cmake).
+    return "env ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}verify_asan_link_order=0\" LD_PRELOAD='" RIG_SEND_RECORDER
+           "' RIG_SEND_LOG='" + recorder_log.string() + "' ";
 }
 
 void expect_only_loopback(const std::set<std::string>& destinations, const fs::path& evidence) {
