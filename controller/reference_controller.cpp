@@ -15,12 +15,7 @@ ReferenceController::ReferenceController(std::string node_name, ControllerConfig
 
 void ReferenceController::configure(DdsContext& dds) {
     nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
-    encoder_reader_ = std::make_unique<Reader<msg::EncoderCount>>(dds, topics::kWheelEncoder);
-    flow_meter_reader_ = std::make_unique<Reader<msg::FlowMeterCount>>(dds, topics::kMainFlowMeter);
-    pump_sensor_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kPumpFlowSensor);
-    boom_height_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kBoomHeightSensor);
-    button_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kBreakpointButton);
-    spray_switch_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kSpraySwitch);
+    device_inputs_ = std::make_unique<BoardInputReaders>(dds);
     actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     status_writer_ = std::make_unique<Writer<msg::ControllerStatus>>(dds, topics::kControllerStatus);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
@@ -32,23 +27,21 @@ void ReferenceController::activate(TimeNs now_ns) {
 }
 
 bool ReferenceController::has_unread_input() const {
-    return nmea_reader_->has_unread() || encoder_reader_->has_unread() || flow_meter_reader_->has_unread() ||
-           pump_sensor_reader_->has_unread() || boom_height_reader_->has_unread() || button_reader_->has_unread() ||
-           spray_switch_reader_->has_unread();
+    return nmea_reader_->has_unread() || device_inputs_->has_unread();
 }
 
 TimeNs ReferenceController::step(TimeNs now_ns) {
     // Fixed order (encoder, meters, sensors, GNSS, panel) keeps runs identical
     // whatever the arrival order across topics.
-    for (const auto& sample : encoder_reader_->take_all()) firmware_.on_encoder_count(sample.count_pulses(), now_ns);
-    for (const auto& sample : flow_meter_reader_->take_all()) {
+    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) firmware_.on_encoder_count(sample.count_pulses(), now_ns);
+    for (const auto& sample : device_inputs_->main_flow_meter.take_all()) {
         firmware_.on_flow_meter_count(sample.count_pulses(), sample.last_edge_capture_us(), now_ns);
     }
-    for (const auto& sample : pump_sensor_reader_->take_all()) firmware_.on_pump_sensor_voltage(sample.voltage_v(), now_ns);
-    for (const auto& sample : boom_height_reader_->take_all()) firmware_.on_boom_height_voltage(sample.voltage_v(), now_ns);
+    for (const auto& sample : device_inputs_->pump_flow_sensor.take_all()) firmware_.on_pump_sensor_voltage(sample.voltage_v(), now_ns);
+    for (const auto& sample : device_inputs_->boom_height_sensor.take_all()) firmware_.on_boom_height_voltage(sample.voltage_v(), now_ns);
     for (const auto& sample : nmea_reader_->take_all()) firmware_.on_nmea_sentence(sample.sentence().to_string(), now_ns);
-    for (const auto& sample : button_reader_->take_all()) firmware_.on_breakpoint_button(sample.closed(), now_ns);
-    for (const auto& sample : spray_switch_reader_->take_all()) firmware_.on_spray_switch(sample.closed(), now_ns);
+    for (const auto& sample : device_inputs_->breakpoint_button.take_all()) firmware_.on_breakpoint_button(sample.closed(), now_ns);
+    for (const auto& sample : device_inputs_->spray_switch.take_all()) firmware_.on_spray_switch(sample.closed(), now_ns);
 
     TimeNs next_wake = firmware_.update(now_ns);
     actuators_writer_->publish_changes(firmware_.actuators());

@@ -20,6 +20,7 @@
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
 #include "rig/actuator_topics.h"
+#include "rig/board_input_topics.h"
 #include "rig/dds_context.h"
 #include "rig/node.h"
 
@@ -37,12 +38,7 @@ public:
 private:
     // --- subscriptions
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
-    std::unique_ptr<Reader<msg::EncoderCount>> encoder_reader_;
-    std::unique_ptr<Reader<msg::FlowMeterCount>> flow_meter_reader_;
-    std::unique_ptr<Reader<msg::AnalogInput>> pump_sensor_reader_;
-    std::unique_ptr<Reader<msg::AnalogInput>> boom_height_reader_;
-    std::unique_ptr<Reader<msg::SwitchLevel>> button_reader_;
-    std::unique_ptr<Reader<msg::SwitchLevel>> spray_switch_reader_;
+    std::unique_ptr<BoardInputReaders> device_inputs_;  // encoder, flow meter, sensors, button, switch
     // --- publications
     std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::ControllerStatus>> status_writer_;

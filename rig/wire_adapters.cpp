@@ -95,12 +95,7 @@ BoardIoAdapter::BoardIoAdapter(BoardIoWire& wire, double update_rate_hz)
     : wire_(wire), period_ns_(seconds_to_ns(1.0 / update_rate_hz)) {}
 
 void BoardIoAdapter::configure(DdsContext& dds) {
-    encoder_reader_ = std::make_unique<Reader<msg::EncoderCount>>(dds, topics::kWheelEncoder);
-    flow_meter_reader_ = std::make_unique<Reader<msg::FlowMeterCount>>(dds, topics::kMainFlowMeter);
-    pump_sensor_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kPumpFlowSensor);
-    boom_height_reader_ = std::make_unique<Reader<msg::AnalogInput>>(dds, topics::kBoomHeightSensor);
-    button_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kBreakpointButton);
-    spray_switch_reader_ = std::make_unique<Reader<msg::SwitchLevel>>(dds, topics::kSpraySwitch);
+    device_inputs_ = std::make_unique<BoardInputReaders>(dds);
     actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
 }
@@ -111,19 +106,19 @@ bool BoardIoAdapter::has_unread_input() const {
 }
 
 void BoardIoAdapter::take_device_topics() {
-    for (const auto& sample : encoder_reader_->take_all()) signals_.wheel_encoder_count = sample.count_pulses();
-    for (const auto& sample : flow_meter_reader_->take_all()) {
+    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) signals_.wheel_encoder_count = sample.count_pulses();
+    for (const auto& sample : device_inputs_->main_flow_meter.take_all()) {
         signals_.main_flow_pulses = sample.count_pulses();
         signals_.main_flow_last_edge_us = sample.last_edge_capture_us();
     }
-    for (const auto& sample : pump_sensor_reader_->take_all()) {
+    for (const auto& sample : device_inputs_->pump_flow_sensor.take_all()) {
         signals_.pump_flow_adc = io::adc_counts_from_voltage(sample.voltage_v());
     }
-    for (const auto& sample : boom_height_reader_->take_all()) {
+    for (const auto& sample : device_inputs_->boom_height_sensor.take_all()) {
         signals_.boom_height_adc = io::adc_counts_from_voltage(sample.voltage_v());
     }
-    for (const auto& sample : button_reader_->take_all()) signals_.breakpoint_button = sample.closed();
-    for (const auto& sample : spray_switch_reader_->take_all()) signals_.spray_switch = sample.closed();
+    for (const auto& sample : device_inputs_->breakpoint_button.take_all()) signals_.breakpoint_button = sample.closed();
+    for (const auto& sample : device_inputs_->spray_switch.take_all()) signals_.spray_switch = sample.closed();
 }
 
 void BoardIoAdapter::publish_outputs(TimeNs now_ns) {

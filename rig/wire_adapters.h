@@ -22,6 +22,7 @@
 #include <string>
 
 #include "rig/actuator_topics.h"
+#include "rig/board_input_topics.h"
 #include "rig/dds_context.h"
 #include "rig/hid_board.h"
 #include "rig/io_image.h"
@@ -135,12 +136,7 @@ private:
     io::DeviceSignals signals_{};
     io::ControllerIndicators seen_indicators_{};
     // --- subscriptions
-    std::unique_ptr<Reader<msg::EncoderCount>> encoder_reader_;
-    std::unique_ptr<Reader<msg::FlowMeterCount>> flow_meter_reader_;
-    std::unique_ptr<Reader<msg::AnalogInput>> pump_sensor_reader_;
-    std::unique_ptr<Reader<msg::AnalogInput>> boom_height_reader_;
-    std::unique_ptr<Reader<msg::SwitchLevel>> button_reader_;
-    std::unique_ptr<Reader<msg::SwitchLevel>> spray_switch_reader_;
+    std::unique_ptr<BoardInputReaders> device_inputs_;  // encoder, flow meter, sensors, button, switch
     // --- publications
     std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
