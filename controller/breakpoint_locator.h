@@ -38,6 +38,9 @@ public:
 
     LocatorEvent on_fix(const FixInput& fix, std::optional<std::uint32_t> latest_count, double speed_m_s);
     LocatorEvent on_encoder(std::uint32_t count);
+    // Forgets the odometer's mileage base, so the next fix inside the threshold
+    // sets s_b again (only the catalogue's stale-fix fault does this).
+    void release_odometer() { odometer_base_count_.reset(); }
 
     double l4_m() const { return l4_m_; }
     // The boom moved: Eq. 6 again with the pull-wire sensor's linkage rise h.

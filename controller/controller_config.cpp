@@ -85,7 +85,36 @@ void read_flow_control(const YamlSection& section, ControllerConfig& config) {
     }
 }
 
+// TEST-ONLY faults (ControllerFaults).
+ControllerFaults read_faults(const YamlSection& section) {
+    ControllerFaults faults;
+    faults.never_resume = section.optional<bool>("never_resume", faults.never_resume);
+    faults.never_spray = section.optional<bool>("never_spray", faults.never_spray);
+    faults.section_chatter_period_s = section.optional_in_range(
+        "section_chatter_period_s", faults.section_chatter_period_s, Bounds::closed(0.0, 60.0));
+    faults.section_chatter_closed_s = section.optional_in_range(
+        "section_chatter_closed_s", faults.section_chatter_closed_s, Bounds::open_closed(0.0, 10.0));
+    if (faults.section_chatter_period_s > 0.0 && !(faults.section_chatter_closed_s < faults.section_chatter_period_s)) {
+        section.fail("section_chatter_closed_s", "must be shorter than section_chatter_period_s");
+    }
+    faults.lead_scale = section.optional_in_range("lead_scale", faults.lead_scale, Bounds::closed(0.0, 20.0));
+    faults.valve_held = section.optional<bool>("valve_held", faults.valve_held);
+    faults.stale_fix_reanchor = section.optional<bool>("stale_fix_reanchor", faults.stale_fix_reanchor);
+    faults.crash_at_s = section.optional_in_range("crash_at_s", faults.crash_at_s, Bounds::closed(0.0, 86400.0));
+    faults.stall_at_s = section.optional_in_range("stall_at_s", faults.stall_at_s, Bounds::closed(0.0, 86400.0));
+    static constexpr std::array<std::string_view, 2> kForgeable = {"truth/vehicle", "truth/hydraulics"};
+    faults.read_topic = section.optional_enum("read_topic", kForgeable, faults.read_topic);
+    faults.write_topic = section.optional_enum("write_topic", kForgeable, faults.write_topic);
+    section.finish();
+    return faults;
+}
+
 }  // namespace
+
+bool ControllerFaults::any() const {
+    return never_resume || never_spray || section_chatter_period_s > 0.0 || lead_scale != 1.0 || valve_held ||
+           stale_fix_reanchor || crash_at_s >= 0.0 || stall_at_s >= 0.0 || !read_topic.empty() || !write_topic.empty();
+}
 
 ControllerConfig parse_controller_config(const YamlSection& section) {
     ControllerConfig config;
@@ -123,6 +152,7 @@ ControllerConfig parse_controller_config(const YamlSection& section) {
     config.breakpoint_store_file = section.optional<std::string>("breakpoint_store_file", config.breakpoint_store_file);
     if (config.breakpoint_store_file.empty()) section.fail("breakpoint_store_file", "must not be empty");
     read_flow_control(section, config);
+    config.faults = read_faults(section.section("faults"));
     section.finish();
     return config;
 }

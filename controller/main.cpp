@@ -65,6 +65,8 @@ int main(int argc, char** argv) {
         rig::FollowerOptions options;
         options.node_name = node_name;
         if (stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(stall_at_s);
+        // TEST-ONLY fault (the catalogue of faulty controllers): the same stall from the case file.
+        if (config.faults.stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(config.faults.stall_at_s);
         rig::DdsContext dds(domain_id, node_name);
         if (wired_mode) {
             if (clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");

@@ -1,5 +1,6 @@
 #include "controller/reference_controller.h"
 
+#include <cstdlib>
 #include <iostream>
 
 #include "idl/topics.h"
@@ -13,12 +14,37 @@ ReferenceController::ReferenceController(std::string node_name, ControllerConfig
       firmware_(std::move(config), state_dir),
       status_period_ns_(seconds_to_ns(1.0 / config_.status_rate_hz)) {}
 
+ReferenceController::~ReferenceController() {
+    if (undeclared_reader_ != nullptr) dds_->subscriber().delete_datareader(undeclared_reader_);
+}
+
 void ReferenceController::configure(DdsContext& dds) {
     nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
     device_inputs_ = std::make_unique<BoardInputReaders>(dds);
     actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     status_writer_ = std::make_unique<Writer<msg::ControllerStatus>>(dds, topics::kControllerStatus);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
+
+    // TEST-ONLY faults. A reader made straight on the DDS subscriber, outside the
+    // context's registry: the hello does not list it, as a controller that hides
+    // what it reads would not. The rig must find it from discovery.
+    dds_ = &dds;
+    const ControllerFaults& faults = config_.faults;
+    if (faults.read_topic == topics::kVehicleTruth) {
+        undeclared_reader_ = dds.subscriber().create_datareader(dds.topic<msg::VehicleTruth>(topics::kVehicleTruth),
+                                                                dds.subscriber().get_default_datareader_qos());
+    } else if (faults.read_topic == topics::kHydraulicsTruth) {
+        undeclared_reader_ = dds.subscriber().create_datareader(
+            dds.topic<msg::HydraulicsTruth>(topics::kHydraulicsTruth), dds.subscriber().get_default_datareader_qos());
+    }
+    if (!faults.read_topic.empty() && undeclared_reader_ == nullptr) {
+        throw std::runtime_error("fault read_topic: cannot create a reader on " + faults.read_topic);
+    }
+    if (faults.write_topic == topics::kVehicleTruth) {
+        forged_vehicle_writer_ = std::make_unique<Writer<msg::VehicleTruth>>(dds, topics::kVehicleTruth);
+    } else if (faults.write_topic == topics::kHydraulicsTruth) {
+        forged_hydraulics_writer_ = std::make_unique<Writer<msg::HydraulicsTruth>>(dds, topics::kHydraulicsTruth);
+    }
 }
 
 void ReferenceController::activate(TimeNs now_ns) {
@@ -31,6 +57,11 @@ bool ReferenceController::has_unread_input() const {
 }
 
 TimeNs ReferenceController::step(TimeNs now_ns) {
+    // TEST-ONLY fault: a firmware that dies mid-case.
+    if (config_.faults.crash_at_s >= 0.0 && now_ns >= seconds_to_ns(config_.faults.crash_at_s)) {
+        std::cerr << name_ << ": crashing at t=" << ns_to_seconds(now_ns) << " s as the fault crash_at_s asks" << std::endl;
+        std::abort();
+    }
     // Fixed order (encoder, meters, sensors, GNSS, panel) keeps runs identical
     // whatever the arrival order across topics.
     for (const auto& sample : device_inputs_->wheel_encoder.take_all()) firmware_.on_encoder_count(sample.count_pulses(), now_ns);
@@ -50,6 +81,28 @@ TimeNs ReferenceController::step(TimeNs now_ns) {
     if (now_ns >= next_status_ns_) {
         status_writer_->publish(firmware_.status(now_ns));
         next_status_ns_ = next_period_boundary(now_ns, status_period_ns_);
+        // TEST-ONLY faults: read what it must not, write what it must not.
+        if (undeclared_reader_ != nullptr) {
+            msg::VehicleTruth vehicle;
+            msg::HydraulicsTruth hydraulics;
+            dds::SampleInfo info;
+            void* sample = config_.faults.read_topic == topics::kVehicleTruth ? static_cast<void*>(&vehicle)
+                                                                              : static_cast<void*>(&hydraulics);
+            while (undeclared_reader_->take_next_sample(sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+            }
+        }
+        if (forged_vehicle_writer_) {
+            msg::VehicleTruth forged;
+            forged.time_ns(now_ns);
+            forged.nozzle_line_along_m(-1000.0);  // a sprayer far from where it is
+            forged_vehicle_writer_->publish(forged);
+        }
+        if (forged_hydraulics_writer_) {
+            msg::HydraulicsTruth forged;
+            forged.time_ns(now_ns);
+            forged.main_flow_l_min(config_.target_flow_l_min);  // "the flow is on target"
+            forged_hydraulics_writer_->publish(forged);
+        }
     }
     return std::min(next_wake, next_status_ns_);
 }

@@ -29,6 +29,7 @@ namespace rig::controller {
 class ReferenceController final : public Node {
 public:
     ReferenceController(std::string node_name, ControllerConfig config, const std::filesystem::path& state_dir);
+    ~ReferenceController() override;
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     void activate(TimeNs now_ns) override;
@@ -43,6 +44,12 @@ private:
     std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::ControllerStatus>> status_writer_;
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
+    // --- TEST-ONLY faults (ControllerFaults): a topic read behind the hello's
+    // back, forged truth written.
+    dds::DataReader* undeclared_reader_ = nullptr;
+    DdsContext* dds_ = nullptr;
+    std::unique_ptr<Writer<msg::VehicleTruth>> forged_vehicle_writer_;
+    std::unique_ptr<Writer<msg::HydraulicsTruth>> forged_hydraulics_writer_;
 
     std::string name_;
     ControllerConfig config_;

@@ -69,7 +69,26 @@ void SprayController::on_nmea_sentence(const std::string& line, TimeNs now_ns) {
 
 void SprayController::handle_fix_complete(TimeNs now_ns) {
     last_fix_->course_deg = last_course_deg_;
+    last_fix_complete_ns_ = now_ns;
+    // TEST-ONLY fault: every fix re-anchors the odometer, stale or not.
+    if (config_.faults.stale_fix_reanchor) locator_.release_odometer();
     on_locator_event(locator_.on_fix(*last_fix_, latest_count_, speed_m_s()), now_ns);
+}
+
+TimeNs SprayController::refeed_stale_fix(TimeNs now_ns) {
+    // TEST-ONLY fault: the last fix is used again as if new while sentences are
+    // missing (a parser whose "valid" flag is never cleared). 0.3 s of silence at
+    // 5 Hz is one missed epoch and a half.
+    constexpr TimeNs kEpochNs = 200'000'000;
+    if (!config_.faults.stale_fix_reanchor || !last_fix_) return kNever;
+    if (now_ns - last_fix_complete_ns_ < kEpochNs + kEpochNs / 2) return last_fix_complete_ns_ + kEpochNs + kEpochNs / 2;
+    if (now_ns >= next_stale_fix_ns_) {
+        const TimeNs real_fix_ns = last_fix_complete_ns_;
+        handle_fix_complete(now_ns);
+        last_fix_complete_ns_ = real_fix_ns;  // still stale: keep counting from the real one
+        next_stale_fix_ns_ = now_ns + kEpochNs;
+    }
+    return next_stale_fix_ns_;
 }
 
 void SprayController::on_encoder_count(std::uint32_t count_pulses, TimeNs now_ns) {
@@ -220,11 +239,13 @@ void SprayController::enter(msg::SprayPhase phase, TimeNs /*now_ns*/) { phase_ =
 
 void SprayController::open_sections(TimeNs now_ns) {
     actuators_.unloading_valve_open = false;
-    actuators_.section_valves_open = static_cast<std::uint8_t>(all_sections_mask());
+    // TEST-ONLY fault: the section outputs are never switched on.
+    if (!config_.faults.never_spray) actuators_.section_valves_open = static_cast<std::uint8_t>(all_sections_mask());
     sections_opened_ns_ = now_ns;
     flow_meter_.reset();
     flow_established_ = false;
     previous_measurement_l_min_.reset();
+    earlier_measurement_l_min_.reset();
     on_target_since_ns_.reset();
 }
 
@@ -238,9 +259,33 @@ void SprayController::start_pre_adjust(TimeNs now_ns) {
     if (!pump_flow_l_min_) return;  // no pump flow reading yet: wait
     valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
     pre_adjusted_pct_ = valve_command_pct_;
-    valve_.move_to(valve_command_pct_, now_ns);
+    command_valve(valve_command_pct_, now_ns);
     pid_.reset();
     enter(msg::SPRAY_PRE_ADJUST, now_ns);
+}
+
+void SprayController::command_valve(double opening_pct, TimeNs now_ns) {
+    if (!config_.faults.valve_held) valve_.move_to(opening_pct, now_ns);
+}
+
+void SprayController::reset_valve(TimeNs now_ns) {
+    if (!config_.faults.valve_held) valve_.start_reset(now_ns);
+}
+
+TimeNs SprayController::apply_section_chatter(TimeNs now_ns) {
+    // TEST-ONLY fault: while the sections should be open, the output drops them
+    // for closed_s at the start of every period after the first.
+    const ControllerFaults& faults = config_.faults;
+    if (faults.section_chatter_period_s <= 0.0 || phase_ != msg::SPRAY_REGULATING || config_.faults.never_spray) {
+        return kNever;
+    }
+    const TimeNs period_ns = seconds_to_ns(faults.section_chatter_period_s);
+    const TimeNs closed_ns = seconds_to_ns(faults.section_chatter_closed_s);
+    const TimeNs since_ns = now_ns - sections_opened_ns_;
+    const TimeNs into_ns = since_ns % period_ns;
+    const bool dropped = since_ns >= period_ns && into_ns < closed_ns;
+    actuators_.section_valves_open = dropped ? 0 : static_cast<std::uint8_t>(all_sections_mask());
+    return now_ns - into_ns + (dropped ? closed_ns : period_ns);  // the next edge of the chatter
 }
 
 bool SprayController::continuation_open_point_reached() const {
@@ -251,20 +296,27 @@ bool SprayController::continuation_open_point_reached() const {
     const double lead_m = config_.hysteresis_compensation
                               ? speed_m_s() * (config_.assumed_flow_adjust_s + config_.assumed_spray_delay_s)
                               : 0.0;
-    return *to_go_m <= lead_m;
+    // TEST-ONLY faults: a wrong lead, or no continuation at all.
+    if (config_.faults.never_resume) return false;
+    return *to_go_m <= lead_m * config_.faults.lead_scale;
 }
 
 void SprayController::regulate(TimeNs now_ns) {
     const std::optional<double> measured = flow_meter_.flow_l_min();
     // The flow counts as established once a whole measurement window lies after the
-    // first pulse and two successive measurements agree: until then the pipeline is
-    // still filling, and a PID acting on the rising reading would wind up.
+    // first pulse and three successive measurements (two PID periods) agree: until
+    // then the pipeline is still filling, and a PID acting on the rising reading
+    // would wind up. Two were not enough over a wire whose reads can stall: one
+    // stalled read repeats the last value and "agrees" with it (seen as the wired
+    // case overshooting the band on a loaded machine).
+    const double agree_l_min = config_.flow_established_change_pct / 100.0 * config_.target_flow_l_min;
     if (!flow_established_ && measured && flow_meter_.first_pulse_ns() &&
         now_ns - *flow_meter_.first_pulse_ns() >= seconds_to_ns(config_.flow_window_s) && previous_measurement_l_min_ &&
-        std::abs(*measured - *previous_measurement_l_min_) <=
-            config_.flow_established_change_pct / 100.0 * config_.target_flow_l_min) {
+        earlier_measurement_l_min_ && std::abs(*measured - *previous_measurement_l_min_) <= agree_l_min &&
+        std::abs(*previous_measurement_l_min_ - *earlier_measurement_l_min_) <= agree_l_min) {
         flow_established_ = true;
     }
+    earlier_measurement_l_min_ = previous_measurement_l_min_;
     previous_measurement_l_min_ = measured;
     if (!flow_established_ || !measured || !pump_flow_l_min_) return;
 
@@ -275,7 +327,7 @@ void SprayController::regulate(TimeNs now_ns) {
     } else {
         valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min + correction_l_min, *pump_flow_l_min_);
     }
-    valve_.move_to(valve_command_pct_, now_ns);
+    command_valve(valve_command_pct_, now_ns);
 
     if (std::abs(error_l_min) <= config_.on_target_band_pct / 100.0 * config_.target_flow_l_min) {
         if (!on_target_since_ns_) on_target_since_ns_ = now_ns;
@@ -301,7 +353,10 @@ TimeNs SprayController::update(TimeNs now_ns) {
             if (!valve_.resetting()) enter(halted_ ? msg::SPRAY_HALTED : msg::SPRAY_IDLE, now_ns);
             break;
         case msg::SPRAY_IDLE:
-            if (spray_switch_on_ && !halted_) start_pre_adjust(now_ns);
+            // TEST-ONLY fault never_resume: once a breakpoint was stored, it never sprays again.
+            if (spray_switch_on_ && !halted_ && !(config_.faults.never_resume && stored_count_ > 0)) {
+                start_pre_adjust(now_ns);
+            }
             break;
         case msg::SPRAY_PRE_ADJUST:
             if (!spray_switch_on_) {
@@ -324,7 +379,7 @@ TimeNs SprayController::update(TimeNs now_ns) {
             if (spray_switch_on_ && locator_.target() && locator_.armed()) {
                 // "When the nearest breakpoint is detected, the proportional control
                 // valve is automatically adjusted to the initial position" (sec. 2.2.1).
-                valve_.start_reset(now_ns);
+                reset_valve(now_ns);
                 enter(msg::SPRAY_APPROACH, now_ns);
             }
             break;
@@ -332,7 +387,7 @@ TimeNs SprayController::update(TimeNs now_ns) {
             if (!valve_.resetting() && !valve_.target_pct() && pump_flow_l_min_) {
                 valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min, *pump_flow_l_min_);
                 pre_adjusted_pct_ = valve_command_pct_;
-                valve_.move_to(valve_command_pct_, now_ns);
+                command_valve(valve_command_pct_, now_ns);
                 pid_.reset();
             }
             if (continuation_open_point_reached()) {
@@ -351,6 +406,8 @@ TimeNs SprayController::update(TimeNs now_ns) {
 
     TimeNs next = next_pid_ns_;
     next = std::min(next, valve_.next_event_ns());
+    next = std::min(next, apply_section_chatter(now_ns));
+    next = std::min(next, refeed_stale_fix(now_ns));
     return next;
 }
 

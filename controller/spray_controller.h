@@ -101,6 +101,13 @@ private:
     void open_sections(TimeNs now_ns);
     void close_sections(TimeNs now_ns);
     void start_pre_adjust(TimeNs now_ns);
+    // The valve driver's commands, through the TEST-ONLY valve_held fault.
+    void command_valve(double opening_pct, TimeNs now_ns);
+    void reset_valve(TimeNs now_ns);
+    // TEST-ONLY faults acting each update: the section chatter and the stale fix.
+    // Return when they next need to run.
+    TimeNs apply_section_chatter(TimeNs now_ns);
+    TimeNs refeed_stale_fix(TimeNs now_ns);
     void regulate(TimeNs now_ns);
     bool continuation_open_point_reached() const;
 
@@ -115,6 +122,8 @@ private:
     // GNSS, assembled from GGA (position, quality) and RMC (course).
     std::optional<FixInput> last_fix_;
     std::optional<double> last_course_deg_;  // kept while standing (RMC course is empty then)
+    TimeNs last_fix_complete_ns_ = 0;        // when the last GGA+RMC epoch completed
+    TimeNs next_stale_fix_ns_ = 0;           // the stale-fix fault's next re-feed
     int last_quality_ = 0;
     std::uint32_t rejected_sentences_ = 0;
 
@@ -135,6 +144,7 @@ private:
     TimeNs sections_opened_ns_ = 0;
     bool flow_established_ = false;
     std::optional<double> previous_measurement_l_min_;
+    std::optional<double> earlier_measurement_l_min_;  // the one before it
     std::optional<TimeNs> on_target_since_ns_;
     bool continuation_on_target_ = false;
     double valve_command_pct_ = 0.0;

@@ -51,7 +51,7 @@ SprayCircuit::SprayCircuit(const Plant& plant, SprayCircuitParams params)
     const double centre = 0.5 * (nozzle_count_ - 1);
     std::stable_sort(nozzles_by_feed_.begin(), nozzles_by_feed_.end(),
                      [centre](int a, int b) { return std::abs(a - centre) < std::abs(b - centre); });
-    section_change_at_ns_.assign(static_cast<std::size_t>(section_count()), 0);
+    section_pending_.assign(static_cast<std::size_t>(section_count()), {});
     pump_flow_l_min_ = params_.pump_flow_l_min;
 }
 
@@ -67,8 +67,12 @@ void SprayCircuit::set_sections_commanded(std::uint16_t open_mask) {
     for (int section = 0; section < section_count(); ++section) {
         const std::uint16_t bit = static_cast<std::uint16_t>(1u << section);
         if ((open_mask & bit) == (sections_commanded_ & bit)) continue;
-        const double delay_s = (open_mask & bit) ? params_.section_valve_open_s : params_.section_valve_close_s;
-        section_change_at_ns_[static_cast<std::size_t>(section)] = now + seconds_to_ns(delay_s);
+        const bool open = (open_mask & bit) != 0;
+        const TimeNs acts_at = now + seconds_to_ns(open ? params_.section_valve_open_s : params_.section_valve_close_s);
+        auto& pending = section_pending_[static_cast<std::size_t>(section)];
+        // A command that would act no later than one still on its way overtakes it.
+        while (!pending.empty() && pending.back().first >= acts_at) pending.pop_back();
+        pending.emplace_back(acts_at, open);
     }
     sections_commanded_ = static_cast<std::uint16_t>(open_mask & ((1u << section_count()) - 1u));
 }
@@ -88,12 +92,14 @@ void SprayCircuit::step_once() {
     const double dt = params_.step_s;
     const double t_s = ns_to_seconds(now);
 
-    // Section valves reach their commanded state after their travel time.
+    // Section valves act on each command after its delay, in order.
     for (int section = 0; section < section_count(); ++section) {
         const std::uint16_t bit = static_cast<std::uint16_t>(1u << section);
-        if ((sections_open_ & bit) != (sections_commanded_ & bit) &&
-            now >= section_change_at_ns_[static_cast<std::size_t>(section)]) {
-            sections_open_ = static_cast<std::uint16_t>(sections_open_ ^ bit);
+        auto& pending = section_pending_[static_cast<std::size_t>(section)];
+        while (!pending.empty() && now >= pending.front().first) {
+            sections_open_ = pending.front().second ? static_cast<std::uint16_t>(sections_open_ | bit)
+                                                    : static_cast<std::uint16_t>(sections_open_ & ~bit);
+            pending.pop_front();
         }
     }
 

@@ -22,6 +22,9 @@
 //               boom), and stops at once when no nozzle can flow;
 //   sections    switch valves open section_valve_open_s after the command and
 //               close section_valve_close_s after it (Table 1: t3 = 0.200 s);
+//               every command edge acts after its delay (a pure dead time), so
+//               a valve told to close and to open again 50 ms later does close,
+//               for 50 ms, 0.2 s later: a chattering output reaches the boom;
 //   nozzles     the flow splits evenly over the open nozzles; each needs
 //               min_nozzle_flow_l_min to spray, so at low flow the nozzles
 //               farthest from the boom centre stop first (sec. 2.4.1: "an
@@ -30,6 +33,7 @@
 //               0.067 s), under the nozzle's position at landing time, and are
 //               booked in the deposition grid under the vehicle's current pass.
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "emulators/ball_valve.h"
@@ -115,7 +119,8 @@ private:
     double main_volume_l_ = 0.0;
     std::uint16_t sections_commanded_ = 0;
     std::uint16_t sections_open_ = 0;
-    std::vector<TimeNs> section_change_at_ns_;  // when each section's valve reaches the commanded state
+    // Per section, the commanded states still on their way: (when it acts, open).
+    std::vector<std::deque<std::pair<TimeNs, bool>>> section_pending_;
     bool unloading_open_ = true;          // at power-on the circuit is unloaded
     int nozzles_spraying_ = 0;
     bool landing_ = false;

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "emulators/gnss_g970.h"
-#include "harness/case_runner.h"
+#include "harness/case_world.h"
 #include "harness/case_spec.h"
 #include "rig/domain_lease.h"
 #include "rig/pty_pair.h"

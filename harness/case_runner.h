@@ -1,19 +1,21 @@
 #pragma once
-// Runs cases: builds the plant and emulators from the case file, starts the
-// controller under test as its own process, drives everything in lockstep,
-// records the trace, computes metrics from truth and judges them.
+// Runs cases. One run of a case, in four parts, each in its own file:
+//   the world      harness/case_world.h    plant, route, operator, receiver, judging plan
+//   the session    harness/case_session.h  DDS domain, bench wires, the controller process
+//   the runner     here                    the nodes driven in lockstep or in real time,
+//                                          every sample recorded (harness/trace_recorder.h)
+//   the judge      harness/judge.h         verdict, metrics and figures from the trace alone
+// A case that fails, errs or is interrupted keeps its trace up to that moment,
+// with the reason in the trace's meta table, and is judged from it like any other.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <vector>
 
-#include "emulators/gnss_g970.h"
-#include "emulators/panel_switch.h"
-#include "emulators/plant.h"
 #include "harness/case_spec.h"
-#include "harness/html_report.h"
-#include "harness/results_writer.h"
+#include "harness/judge.h"
 
 namespace rig::harness {
 
@@ -25,40 +27,30 @@ struct RunOptions {
     std::filesystem::path controller_executable = "rig-controller";
 };
 
-// What the case's vehicle does and its operator presses (harness/case_runner.cpp).
-struct ScenarioPlan {
-    std::vector<emulators::RoutePhase> route;
-    double start_along_m = 0.0;  // nozzle line at t = 0
-    std::vector<emulators::SwitchClosure> button;
-    std::vector<emulators::SwitchClosure> spray_switch;
-    double approach_starts_s = 0.0;
-};
-
-// The case's world as `rig run` builds it: the plant, the operator's script and
-// the G970II's parameters. Bench tools (`rig emulate gnss`) use the same.
-struct CaseWorld {
-    emulators::Plant plant;
-    ScenarioPlan scenario;
-    emulators::G970Params gnss;
-    double breakpoint_crossing_s = 0.0;  // on the approach; NaN in a static test
-    TimeNs end_ns = 0;
-};
-CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed);
-
 // Checks that need more than the file itself (e.g. the reference controller's
 // own parameters); throws rig::ConfigError naming file, line and key.
 void validate_for_run(const CaseSpec& spec, const RunOptions& options);
 
-// A case's verdict and what the report draws of it (Fig. 14 flow curve, Fig. 15 dose).
-struct CaseRun {
-    CaseResult result;
-    CaseFigures figures;
+// One run of a case file: a seed and the name its outputs go under.
+struct CaseInstance {
+    std::size_t spec_index = 0;
+    std::uint64_t seed = 1;
+    std::string name;  // the case's name, or NAME-seedN for a case with `seeds:`
 };
+// The runs the case files ask for, in order (a `seeds:` case gives one per seed;
+// --seed gives one run with that seed).
+std::vector<CaseInstance> expand_runs(const std::vector<CaseSpec>& specs, const RunOptions& options);
 
-// Runs one case to the end (or to the first failure); never throws.
+// Runs one case to the end (or to the first failure) and judges its trace;
+// never throws.
+CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options);
+// The same with the case's own seed (or --seed) and name.
 CaseRun run_case(const CaseSpec& spec, const RunOptions& options);
 
-// Runs cases `options.jobs` at a time, printing one progress line per case.
+// Runs every expanded case `options.jobs` at a time (real-time cases alone,
+// after the others), printing one progress line per case. After SIGINT /
+// SIGTERM (harness/run_interrupt.h) the running cases end as interrupted and
+// the rest are reported as not run.
 std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress);
 
 }  // namespace rig::harness

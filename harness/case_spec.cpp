@@ -1,11 +1,14 @@
 #include "harness/case_spec.h"
 
+#include "rig/lockstep.h"
 #include "rig/modbus_protocol.h"
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <fstream>
 #include <optional>
+#include <sstream>
 #include <system_error>
 
 namespace rig::harness {
@@ -299,6 +302,10 @@ DepositionSpec read_deposition(const YamlSection& section) {
     deposition.cv_row_m = section.optional_in_range<double>("cv_row_m", deposition.cv_row_m, Bounds::closed(0.01, 5));
     deposition.cv_window_m =
         section.optional_in_range<double>("cv_window_m", deposition.cv_window_m, Bounds::closed(0.1, 100));
+    deposition.strip_start_allowance_m = section.optional_in_range<double>(
+        "strip_start_allowance_m", deposition.strip_start_allowance_m, Bounds::closed(0, 100));
+    deposition.strip_end_allowance_m = section.optional_in_range<double>(
+        "strip_end_allowance_m", deposition.strip_end_allowance_m, Bounds::closed(0, 100));
     return deposition;
 }
 
@@ -370,6 +377,16 @@ std::map<std::string, double> read_limits(const YamlSection& section) {
 ExpectSpec read_expect(const YamlSection& section) {
     ExpectSpec expect;
     expect.fail = section.string_list("fail");
+    if (section.has("error")) {
+        expect.error = section.required<std::string>("error");
+        if (!failure_kind_from_string(expect.error)) {
+            section.fail("error", "'" + expect.error + "' is not a kind of run failure; one of: " + failure_kind_names());
+        }
+        if (!expect.fail.empty()) {
+            section.fail("error", "a case that must end in an error cannot also expect metrics to break (`fail`): "
+                                  "an errored case is not judged on its metrics");
+        }
+    }
     return expect;
 }
 
@@ -390,6 +407,14 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                                                     number_text(spec.breakpoint.along_m) +
                                                     ") so the vehicle approaches the breakpoint, got " +
                                                     number_text(spec.vehicle.start_m));
+    }
+    if (spec.scenario == Scenario::breakpoint_continuation) {
+        const double strip_m = spec.vehicle.first_pass_m + spec.vehicle.overrun_m;
+        if (!(spec.deposition.strip_start_allowance_m + spec.deposition.strip_end_allowance_m < strip_m)) {
+            root.section("deposition").fail("strip_end_allowance_m",
+                                            "the allowances leave nothing of the " + number_text(strip_m) +
+                                                " m strip to judge (vehicle.first_pass_m + vehicle.overrun_m)");
+        }
     }
     if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
         root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
@@ -489,6 +514,24 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     }
     spec.description = root.optional<std::string>("description", "");
     spec.seed = root.optional<std::uint64_t>("seed", spec.seed);
+    if (root.has("seeds")) {
+        if (root.has("seed")) root.fail("seeds", "give either `seed` or `seeds`, not both");
+        const std::vector<std::string> seeds = root.string_list("seeds");
+        if (seeds.empty()) root.fail("seeds", "must list at least one seed");
+        for (std::size_t index = 0; index < seeds.size(); ++index) {
+            std::uint64_t seed = 0;
+            const auto [end, error] = std::from_chars(seeds[index].data(), seeds[index].data() + seeds[index].size(), seed);
+            if (error != std::errc{} || end != seeds[index].data() + seeds[index].size()) {
+                throw ConfigError(root.item_location("seeds", index),
+                                  "a seed is a whole number >= 0, got '" + seeds[index] + "'");
+            }
+            if (std::find(spec.seeds.begin(), spec.seeds.end(), seed) != spec.seeds.end()) {
+                throw ConfigError(root.item_location("seeds", index), "seed " + seeds[index] + " is listed twice");
+            }
+            spec.seeds.push_back(seed);
+        }
+        spec.seed = spec.seeds.front();
+    }
     spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
     spec.scenario = root.optional_enum<Scenario>("scenario", kScenarios, spec.scenario);
     spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);
@@ -527,11 +570,18 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
 
 CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name,
                     const std::map<std::string, double>& default_limits) {
-    return read_case(YamlSection::load_string(yaml_text, file_name.string()), file_name, default_limits);
+    CaseSpec spec = read_case(YamlSection::load_string(yaml_text, file_name.string()), file_name, default_limits);
+    spec.source_text = std::string(yaml_text);
+    return spec;
 }
 
 CaseSpec load_case_file(const std::filesystem::path& path, const std::map<std::string, double>& default_limits) {
-    return read_case(YamlSection::load_file(path), path, default_limits);
+    CaseSpec spec = read_case(YamlSection::load_file(path), path, default_limits);
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    spec.source_text = text.str();
+    return spec;
 }
 
 std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args) {

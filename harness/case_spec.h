@@ -176,6 +176,12 @@ struct DepositionSpec {
     double sprayed_fraction = 0.5;   // a row counts as sprayed above this share of the pass's nominal dose
     double cv_row_m = 0.3;           // rows for the CV of Eq. 10-12 (the paper's filter papers were 30 cm apart)
     double cv_window_m = 6.0;        // operational / continuation areas: this far either side of the repeated one
+    // The strip that must be sprayed (missed_m) runs from the first pass's start
+    // to the end of the continuation, less these allowances at either end: the
+    // sprayer starts from standstill and stops at the end of its run, where
+    // section valves and the zero-speed shutoff act (not the breakpoint's business).
+    double strip_start_allowance_m = 1.0;
+    double strip_end_allowance_m = 1.0;
 };
 
 // The static tests: spray switch on at spray_on_at_s for spray_for_s (vehicle standing).
@@ -227,6 +233,10 @@ struct ExpectSpec {
     // Metrics that must break their limits (a negative case): the case passes
     // only when exactly these fail. Each must have a limit (file or default).
     std::vector<std::string> fail;
+    // Or: the run must end in this kind of failure (rig::FailureKind names, e.g.
+    // node_exited, node_unresponsive, topic_role_violation); the case passes
+    // only when it does. Exclusive with `fail`.
+    std::string error;
 };
 
 struct TimeoutsSpec {
@@ -239,6 +249,10 @@ struct CaseSpec {
     std::string name;  // required, [A-Za-z0-9._-]+
     std::string description;
     std::uint64_t seed = 1;  // `rig run --seed` overrides
+    // `seeds: [..]` instead of `seed`: the case runs once per seed, as NAME-seedN
+    // (a faulty controller must be caught on every one).
+    std::vector<std::uint64_t> seeds;
+    std::string source_text;  // the file as written (kept in the trace)
     RunMode mode = RunMode::lockstep;
     Scenario scenario = Scenario::breakpoint_identification;
     std::string utc_start_iso = "2023-07-15T02:00:00Z";

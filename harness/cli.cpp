@@ -1,5 +1,6 @@
 // `rig`: the rig's one command line (DESIGN.md "Command line").
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
+//   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
 //   rig dds-check [--samples N] [--log-dir DIR]
 //   rig modbus serve [--tcp ADDRESS:PORT | --rtu DEVICE ...] [synthetic signal options]
@@ -18,7 +19,9 @@
 #include "harness/bench_serial.h"
 #include "harness/case_runner.h"
 #include "harness/html_report.h"
+#include "harness/judge_command.h"
 #include "harness/results_writer.h"
+#include "harness/run_interrupt.h"
 #include "rig/clock.h"
 #include "rig/config_error.h"
 #include "rig/dds_check.h"
@@ -54,6 +57,9 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         std::cerr << "rig: " << error.what() << "\n";
         return 2;
     }
+    // SIGINT / SIGTERM from here on stop the cases, not the rig: the results of
+    // what ran are still written (harness/run_interrupt.h).
+    install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
     const auto runs = run_cases(specs, options, std::cerr);
     std::vector<CaseResult> results;
@@ -71,6 +77,10 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
               << (options.out_dir / "report.txt").string() << ", " << (options.out_dir / "report.html").string()
               << "\n";
+    if (const int signal = run_interrupt_signal()) {
+        std::cerr << "rig: interrupted by signal " << signal << "; the cases that ran are in the results\n";
+        return 128 + signal;
+    }
     return summary.failed == 0 ? 0 : 1;
 }
 
@@ -100,6 +110,14 @@ int main(int argc, char** argv) {
     auto* seed_option = run->add_option("--seed", seed, "override every case's seed");
     run->add_option("--jobs", run_options.jobs, "cases run at once, each on its own DDS domain")
         ->check(CLI::Range(1, 16));
+
+    rig::harness::JudgeCommandOptions judge_options;
+    auto* judge = app.add_subcommand(
+        "judge", "judge recorded traces again (a run's --out directory, or trace files): same results contract");
+    judge->add_option("runs_or_traces", judge_options.inputs, "rig run --out directories or trace.sqlite files")->required();
+    judge->add_option("--out", judge_options.out_dir, "write results.json, junit.xml and the reports here");
+    judge->add_flag("--check", judge_options.check,
+                    "compare with each directory's results.json: metrics, verdicts and digests must be the same");
 
     auto* nmea = app.add_subcommand("nmea", "NMEA tools");
     nmea->require_subcommand(1);
@@ -137,6 +155,7 @@ int main(int argc, char** argv) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         return run_command(case_inputs, run_options);
     }
+    if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);
     if (decode->parsed()) return nmea_decode_command(nmea_input);
     if (modbus_serve->parsed()) return rig::harness::run_modbus_serve_command(modbus_serve_options);
     if (check->parsed()) {

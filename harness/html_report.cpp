@@ -949,7 +949,6 @@ std::string case_anchor(std::size_t index) { return "case-" + std::to_string(ind
 std::string failure_items(const CaseResult& result) {
     const bool expected = verdict_of(result) == Verdict::expected_failure_ok;
     std::string items;
-    if (!result.error.empty()) items += "<li>error: " + html(result.error) + "</li>";
     for (const std::string& failure : result.failures) {
         items += "<li>" + html(failure) + (expected ? " <span class=\"expected\">(expected)</span>" : "") + "</li>";
     }
@@ -1011,6 +1010,9 @@ std::string metrics_table(const CaseResult& result) {
         const auto limit_value = result.limits.find(name);
         const std::string css = limit_class(result, state);
         std::string value_text = "missing";
+        if (const auto why = result.not_measured.find(name); why != result.not_measured.end()) {
+            value_text = "not measured: " + why->second;
+        }
         if (value != result.metrics.end()) {
             value_text = limit_value == result.limits.end() ? shown_number(value->second, 6)
                                                             : shown_against(value->second, limit_value->second);
@@ -1018,7 +1020,10 @@ std::string metrics_table(const CaseResult& result) {
         std::string state_text;
         if (state == LimitState::within) state_text = "within";
         if (state == LimitState::over) state_text = css == "expected" ? "over (expected)" : "over";
-        if (state == LimitState::missing) state_text = "not measured";
+        if (state == LimitState::missing) {
+            state_text = result.not_measured.count(name) ? (css == "expected" ? "broken (expected)" : "broken")
+                                                         : "not measured";
+        }
         const bool highlighted = state == LimitState::over || state == LimitState::missing;
         const std::string limit_text =
             limit_value == result.limits.end() ? std::string() : shown_number(limit_value->second, 6);
@@ -1135,8 +1140,9 @@ std::string case_section(PageBuilder& page, std::size_t index, const CaseResult&
     section += "<h2>" + std::to_string(index + 1) + ". " + html(result.name) + " " + verdict_badge(verdict_of(result)) +
                "</h2>\n";
     if (!result.error.empty()) {
-        section += "<div class=\"error-box\"><strong>The case did not run to the end:</strong>\n<pre>" +
-                   html(result.error) + "</pre></div>\n";
+        section += "<div class=\"error-box\"><strong>The case did not run to the end (" + html(result.error_kind) +
+                   (verdict_of(result) == Verdict::expected_failure_ok ? ", as the case expects" : "") +
+                   "):</strong>\n<pre>" + html(result.error) + "</pre>The trace keeps every sample up to it.</div>\n";
     }
     section += case_facts(result);
     section += "<h3>Metrics</h3>\n" + metrics_table(result);

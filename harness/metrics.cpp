@@ -2,77 +2,305 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <numeric>
-
-#include "idl/topics.h"
 
 namespace rig::harness {
 
-std::map<std::string, double> breakpoint_metrics(const TraceRecorder& trace, const emulators::Plant& plant,
-                                                 double breakpoint_along_m) {
-    std::map<std::string, double> metrics;
+namespace {
+
+std::string seconds_text(TimeNs t) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.3f s", ns_to_seconds(t));
+    return buffer;
+}
+
+std::string number_text(double value, int decimals = 2) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+    return buffer;
+}
+
+}  // namespace
+
+void MetricSet::merge(const MetricSet& other) {
+    for (const auto& [name, value] : other.values) {
+        values[name] = value;
+        not_measured.erase(name);
+    }
+    for (const auto& [name, reason] : other.not_measured) {
+        if (!values.count(name)) not_measured[name] = reason;
+    }
+}
+
+// ---------------------------------------------------------------- vehicle track
+
+VehicleTrack::VehicleTrack(std::vector<VehicleSample> samples) : samples_(std::move(samples)) {
+    std::stable_sort(samples_.begin(), samples_.end(),
+                     [](const VehicleSample& a, const VehicleSample& b) { return a.t_ns < b.t_ns; });
+}
+
+std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const {
+    if (samples_.empty()) return std::nullopt;
+    const auto after = std::lower_bound(samples_.begin(), samples_.end(), t,
+                                        [](const VehicleSample& sample, TimeNs at) { return sample.t_ns < at; });
+    if (after != samples_.end() && after->t_ns == t) return after->nozzle_line_along_m;
+    if (after == samples_.begin()) return after->nozzle_line_along_m;  // before the first sample: standing there
+    const VehicleSample& before = *std::prev(after);
+    if (after == samples_.end()) return before.nozzle_line_along_m;  // after the last: where it stood
+    // Across a headland turn the two neighbours are on different passes: the
+    // vehicle was on `before`'s pass until the reposition, which the truth
+    // stream dates to its first sample of the new pass at the latest.
+    if (before.pass_index != after->pass_index) return before.nozzle_line_along_m;
+    const double fraction =
+        static_cast<double>(t - before.t_ns) / static_cast<double>(after->t_ns - before.t_ns);
+    return before.nozzle_line_along_m + fraction * (after->nozzle_line_along_m - before.nozzle_line_along_m);
+}
+
+std::optional<TimeNs> VehicleTrack::pass_start_ns(int pass_index) const {
+    for (const VehicleSample& sample : samples_) {
+        if (sample.pass_index == pass_index) return sample.t_ns;
+    }
+    return std::nullopt;
+}
+
+// ---------------------------------------------------------------- breakpoint identification
+
+MetricSet breakpoint_metrics(const std::vector<BreakpointEventSample>& events, const VehicleTrack& track,
+                             const emulators::FieldFrame& field, double breakpoint_along_m) {
+    MetricSet metrics;
     int reached = 0;
-    for (const auto& [t, event] : trace.samples(topics::kBreakpointEvent)) {
-        const std::string kind = event.at("kind");
-        // A board on Modbus or HID reports only that it stored one, not where (null position).
-        if (kind == "stored" && !metrics.count("breakpoint_store_error_m") && event.at("lat_deg").is_number() &&
-            std::isfinite(event.at("lat_deg").get<double>())) {
-            const emulators::GeoPoint stored{event.at("lat_deg"), event.at("lon_deg"), 0.0};
-            const auto [along_m, cross_m] = plant.field().to_line(stored);
-            metrics["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m);
+    for (const BreakpointEventSample& event : events) {
+        // A board on Modbus or HID reports only that it stored one, not where (no position).
+        if (event.kind == "stored" && !metrics.values.count("breakpoint_store_error_m") && event.lat_deg &&
+            event.lon_deg && std::isfinite(*event.lat_deg) && std::isfinite(*event.lon_deg)) {
+            const auto [along_m, cross_m] = field.to_line(emulators::GeoPoint{*event.lat_deg, *event.lon_deg, 0.0});
+            metrics.values["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m);
         }
-        if (kind == "reached") {
-            if (++reached == 1) {
-                // Truth at the instant the controller decided (its sample time).
-                const double nozzle_along_m = plant.truth_at(t).nozzle_line_along_m();
-                metrics["breakpoint_error_signed_m"] = nozzle_along_m - breakpoint_along_m;
-                metrics["breakpoint_error_m"] = std::abs(nozzle_along_m - breakpoint_along_m);
-                metrics["breakpoint_reached_at_s"] = ns_to_seconds(t);
+        if (event.kind == "reached" && ++reached == 1) {
+            // Truth at the instant the controller decided (the trace holds the plant's state then).
+            if (const auto nozzle_along_m = track.nozzle_line_along_m(event.t_ns)) {
+                metrics.values["breakpoint_error_signed_m"] = *nozzle_along_m - breakpoint_along_m;
+                metrics.values["breakpoint_error_m"] = std::abs(*nozzle_along_m - breakpoint_along_m);
+                metrics.values["breakpoint_reached_at_s"] = ns_to_seconds(event.t_ns);
             }
         }
     }
-    metrics["breakpoint_reached_count"] = reached;
+    metrics.values["breakpoint_reached_count"] = reached;
+    if (reached == 0) {
+        metrics.not_measured["breakpoint_error_m"] = "never declared: the controller did not report the breakpoint reached";
+    }
+    if (!metrics.values.count("breakpoint_store_error_m")) {
+        const bool stored = std::any_of(events.begin(), events.end(), [](const auto& e) { return e.kind == "stored"; });
+        metrics.not_measured["breakpoint_store_error_m"] =
+            stored ? "the controller reported a stored breakpoint without its position (e.g. over Modbus)"
+                   : "never stored: the controller reported no stored breakpoint";
+    }
     return metrics;
 }
 
-std::map<std::string, double> flow_metrics(const std::vector<MainFlowSample>& samples, const FlowEpisode& episode,
-                                           double target_l_min, double band_pct, double never_settled_after_s) {
-    std::map<std::string, double> metrics;
-    const double band_l_min = band_pct / 100.0 * target_l_min;
-    // The last instant the flow was outside the band; settled from the next sample on.
-    bool settled = false;
-    TimeNs settled_ns = episode.end_ns;
+// ---------------------------------------------------------------- flow control
+
+std::vector<FlowReading> kf11_readings(const std::vector<FlowMeterCountSample>& samples, double pulses_per_l,
+                                       double window_s) {
+    std::vector<FlowReading> readings;
+    // Edges seen so far, as (count, capture time) of the samples where the count changed.
+    struct Edge {
+        std::uint32_t count;
+        std::uint32_t capture_us;
+    };
+    std::vector<Edge> edges;
+    TimeNs last_edge_seen_ns = 0;
+    const auto window_us = static_cast<std::uint32_t>(std::llround(window_s * 1e6));
+    for (const FlowMeterCountSample& sample : samples) {
+        if (edges.empty() || sample.count_pulses != edges.back().count) {
+            edges.push_back(Edge{sample.count_pulses, sample.last_edge_capture_us});
+            last_edge_seen_ns = sample.t_ns;
+        }
+        // No pulse for twice the window: the flow has stopped (the count alone cannot say so).
+        if (sample.t_ns - last_edge_seen_ns > seconds_to_ns(2.0 * window_s)) {
+            readings.push_back(FlowReading{sample.t_ns, 0.0});
+            continue;
+        }
+        const Edge& last = edges.back();
+        // The latest earlier edge at least window_s before the last one.
+        const Edge* base = nullptr;
+        for (auto it = edges.rbegin() + 1; it != edges.rend(); ++it) {
+            if (static_cast<std::uint32_t>(last.capture_us - it->capture_us) >= window_us) {
+                base = &*it;
+                break;
+            }
+        }
+        if (base == nullptr) {
+            readings.push_back(FlowReading{sample.t_ns, 0.0});
+            continue;
+        }
+        const double pulses = static_cast<std::uint32_t>(last.count - base->count);
+        const double t2_s = static_cast<std::uint32_t>(last.capture_us - base->capture_us) * 1e-6;
+        readings.push_back(FlowReading{sample.t_ns, 60.0 * pulses / (pulses_per_l * t2_s)});  // Eq. 3
+        // Keep the edge list short: nothing older than the base is needed again.
+        const auto keep_from = static_cast<std::size_t>(base - edges.data());
+        if (keep_from > 64) edges.erase(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(keep_from));
+    }
+    return readings;
+}
+
+FlowResult flow_metrics(const std::vector<HydraulicsSample>& hydraulics, const std::vector<SectionCommand>& commands,
+                        const std::vector<FlowReading>& kf11, const FlowWindow& window, const FlowJudging& judging) {
+    FlowResult result;
+    MetricSet& metrics = result.metrics;
+    const char* adjust_names[] = {"flow_adjust_time_s", "flow_adjust_time_from_command_s"};
+
+    // Openings: the section command going from all closed to any open.
+    std::vector<TimeNs> openings;
+    std::uint16_t previous = 0;
+    for (const SectionCommand& command : commands) {
+        if (command.t_ns >= window.to_ns) break;
+        if (previous == 0 && command.open_mask != 0 && command.t_ns >= window.from_ns) openings.push_back(command.t_ns);
+        previous = command.open_mask;
+    }
+    if (openings.empty()) {
+        const std::string reason = "never settled: the sections never opened between " + seconds_text(window.from_ns) +
+                                   " and " + seconds_text(window.to_ns);
+        for (const char* name : adjust_names) metrics.not_measured[name] = reason;
+        metrics.not_measured["flow_error_pct"] = reason;
+        metrics.values["flow_settled"] = 0.0;
+        return result;
+    }
+    const TimeNs first_open_ns = openings.front();
+    result.first_open_ns = first_open_ns;
+
+    // The settle instant: the first in-band sample after the last out-of-band one,
+    // provided the flow is still in the band at the window's end.
+    const double band_l_min = judging.band_pct / 100.0 * judging.target_l_min;
+    auto in_band = [&](const HydraulicsSample& sample) {
+        return std::abs(sample.main_flow_l_min - judging.target_l_min) <= band_l_min;
+    };
+    // The start of the current in-band stretch (kNever while out of the band).
+    TimeNs settled_ns = kNever;
+    std::optional<TimeNs> first_spraying_ns;  // the nozzles starting after the first opening
+    // The nozzles starting (truth): the section valves going from all shut to any
+    // open. A command that drops and restores the sections too briefly for the
+    // valves to act is no restart; one that empties the boom line is.
+    std::vector<TimeNs> nozzle_starts;
+    std::uint16_t spraying_before = 0;
     bool any = false;
-    for (const MainFlowSample& sample : samples) {
-        if (sample.t_ns < episode.open_command_ns || sample.t_ns > episode.end_ns) continue;
+    for (const HydraulicsSample& sample : hydraulics) {
+        if (sample.t_ns < first_open_ns) {
+            spraying_before = sample.sections_spraying_mask;
+            continue;
+        }
+        if (sample.t_ns >= window.to_ns) break;
         any = true;
-        if (std::abs(sample.main_flow_l_min - target_l_min) > band_l_min) {
-            settled = false;
-        } else if (!settled) {
-            settled = true;
+        if (spraying_before == 0 && sample.sections_spraying_mask != 0) nozzle_starts.push_back(sample.t_ns);
+        spraying_before = sample.sections_spraying_mask;
+        if (!in_band(sample)) {
+            settled_ns = kNever;
+        } else if (settled_ns == kNever) {
             settled_ns = sample.t_ns;
         }
     }
-    if (!any) return metrics;
-    if (!settled) settled_ns = episode.end_ns;
-    const TimeNs error_from_ns = settled ? settled_ns : episode.open_command_ns + seconds_to_ns(never_settled_after_s);
-    metrics["flow_settled"] = settled ? 1.0 : 0.0;
-    metrics["flow_adjust_time_s"] = ns_to_seconds(settled_ns - episode.open_command_ns);
-    double error_sum = 0.0;
-    double flow_sum = 0.0;
-    int count = 0;
-    for (const MainFlowSample& sample : samples) {
-        if (sample.t_ns < error_from_ns || sample.t_ns > episode.end_ns) continue;
-        error_sum += std::abs(sample.main_flow_l_min - target_l_min) / target_l_min;
-        flow_sum += sample.main_flow_l_min;
-        ++count;
+    if (!nozzle_starts.empty()) first_spraying_ns = nozzle_starts.front();
+    if (nozzle_starts.size() > 1) metrics.values["flow_nozzle_starts_count"] = static_cast<double>(nozzle_starts.size());
+    // Where the error counts from: the settling, or the moment the flow was due to
+    // be steady (settle_by_s after the nozzles first started in the window) if
+    // that came first. Restarts in the window are the controller's own doing
+    // (it drives on through it): they do not move that moment.
+    std::optional<TimeNs> error_from_ns;
+    if (!any || settled_ns == kNever) {
+        std::string reason = "never settled: the main flow was outside " + number_text(judging.target_l_min, 1) +
+                             " L/min +-" + number_text(judging.band_pct, 1) + " % at the end of the judged window (" +
+                             seconds_text(window.to_ns) + ")";
+        if (!any) reason = "never settled: no flow sample between the opening and the window's end";
+        if (nozzle_starts.size() > 1) reason += ", after the nozzles started " + std::to_string(nozzle_starts.size()) + " times";
+        for (const char* name : adjust_names) metrics.not_measured[name] = reason;
+        metrics.values["flow_settled"] = 0.0;
+        if (!nozzle_starts.empty()) {
+            error_from_ns = nozzle_starts.front() + seconds_to_ns(judging.settle_by_s);
+        } else {
+            metrics.not_measured["flow_error_pct"] = "the nozzles never started in the judged window";
+        }
+    } else {
+        // Each restart of the nozzles starts the adjustment again: it is timed from
+        // the last start before the flow settled for good (sec. 3.1.2: "from nozzle
+        // start"), and from the open command that started it.
+        const TimeNs settle_ns = settled_ns;
+        TimeNs nozzles_ns = first_open_ns;
+        for (TimeNs start_ns : nozzle_starts) {
+            if (start_ns <= settle_ns) nozzles_ns = start_ns;
+        }
+        const TimeNs open_ns = *std::prev(std::upper_bound(openings.begin(), openings.end(), nozzles_ns));
+        metrics.values["flow_settled"] = 1.0;
+        metrics.values["flow_adjust_time_from_command_s"] = ns_to_seconds(settle_ns - open_ns);
+        metrics.values["flow_adjust_time_s"] = ns_to_seconds(settle_ns - nozzles_ns);
+        error_from_ns = std::min(settle_ns, first_spraying_ns.value_or(nozzles_ns) + seconds_to_ns(judging.settle_by_s));
     }
-    if (count > 0) {
-        metrics["flow_error_pct"] = 100.0 * error_sum / count;
-        metrics["flow_mean_l_min"] = flow_sum / count;
+    if (error_from_ns) {
+        double error_sum = 0.0;
+        double flow_sum = 0.0;
+        int count = 0;
+        for (const HydraulicsSample& sample : hydraulics) {
+            if (sample.t_ns < *error_from_ns || sample.t_ns >= window.to_ns) continue;
+            error_sum += std::abs(sample.main_flow_l_min - judging.target_l_min) / judging.target_l_min;
+            flow_sum += sample.main_flow_l_min;
+            ++count;
+        }
+        if (count > 0) {
+            metrics.values["flow_error_pct"] = 100.0 * error_sum / count;
+            metrics.values["flow_mean_l_min"] = flow_sum / count;
+        } else {
+            metrics.not_measured["flow_error_pct"] = "the judged window ended before the flow was due to be steady";
+        }
+    }
+
+    // The paper's way (Table 5): the controller's own meter readings, signed.
+    auto kf11_signed_error = [&](TimeNs from_ns) -> std::optional<double> {
+        double sum = 0.0;
+        int count = 0;
+        for (const FlowReading& reading : kf11) {
+            if (reading.t_ns < from_ns || reading.t_ns >= window.to_ns) continue;
+            sum += reading.flow_l_min;
+            ++count;
+        }
+        if (count == 0) return std::nullopt;
+        return 100.0 * (sum / count - judging.target_l_min) / judging.target_l_min;
+    };
+    if (first_spraying_ns) {
+        if (const auto error = kf11_signed_error(*first_spraying_ns)) {
+            metrics.values["flow_error_kf11_signed_pct"] = *error;
+        }
+    }
+    if (settled_ns != kNever) {
+        if (const auto error = kf11_signed_error(settled_ns)) {
+            metrics.values["flow_error_kf11_settled_signed_pct"] = *error;
+        }
+    }
+    return result;
+}
+
+MetricSet spray_timing_metrics(const std::vector<SectionCommand>& commands,
+                               const std::vector<HydraulicsSample>& hydraulics,
+                               const std::vector<LandingEdgeSample>& landing_edges) {
+    MetricSet metrics;
+    const auto first_open = std::find_if(commands.begin(), commands.end(), [](const auto& c) { return c.open_mask != 0; });
+    if (first_open == commands.end()) return metrics;
+    for (const HydraulicsSample& sample : hydraulics) {
+        if (sample.t_ns >= first_open->t_ns && sample.sections_spraying_mask != 0) {
+            metrics.values["section_valve_open_delay_s"] = ns_to_seconds(sample.t_ns - first_open->t_ns);
+            break;
+        }
+    }
+    for (const LandingEdgeSample& edge : landing_edges) {
+        if (edge.landing && edge.t_ns >= first_open->t_ns) {
+            metrics.values["spray_landing_delay_s"] = ns_to_seconds(edge.t_ns - first_open->t_ns);
+            break;
+        }
     }
     return metrics;
 }
+
+// ---------------------------------------------------------------- deposition
 
 double coefficient_of_variation_pct(const std::vector<double>& rows) {
     if (rows.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -112,6 +340,7 @@ std::vector<double> cv_rows(const DoseProfile& profile, const std::vector<double
 DepositionResult deposition_metrics(const DoseProfile& profile, const DepositionJudging& judging,
                                     double breakpoint_along_m) {
     DepositionResult result;
+    MetricSet& metrics = result.metrics;
     const std::size_t rows = std::max(profile.first_pass.size(), profile.continuation.size());
     const double threshold = judging.sprayed_fraction * judging.nominal_dose_ul_cm2;
     auto dose = [](const std::vector<double>& layer, std::size_t row) { return row < layer.size() ? layer[row] : 0.0; };
@@ -134,22 +363,34 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
             last_both = row;
         }
     }
+    // Missed: rows of the strip the case says must be sprayed that neither pass
+    // sprayed, whatever the controller did (a row belongs to the strip when its
+    // centre does). Rows outside the grid count as unsprayed.
     double missed_m = 0.0;
-    std::optional<std::size_t> gap_start;
-    if (first_sprayed) {
-        for (std::size_t row = *first_sprayed; row <= *last_sprayed; ++row) {
-            if (!sprayed(profile.first_pass, row) && !sprayed(profile.continuation, row)) {
-                missed_m += profile.row_m;
-                if (!gap_start) gap_start = row;
-            } else if (gap_start) {
-                result.areas.push_back({"missed", profile.row_centre_m(*gap_start) - 0.5 * profile.row_m,
-                                        profile.row_centre_m(row) - 0.5 * profile.row_m});
-                gap_start.reset();
-            }
+    std::optional<double> gap_from_m;
+    const auto strip_rows = static_cast<long>(
+        std::floor((judging.strip_to_m - judging.strip_from_m) / profile.row_m + 1e-9));
+    const long first_strip_row =
+        static_cast<long>(std::ceil((judging.strip_from_m - profile.first_row_centre_m) / profile.row_m - 1e-9));
+    for (long k = 0; k <= strip_rows; ++k) {
+        const long row = first_strip_row + k;
+        const double centre_m = profile.first_row_centre_m + static_cast<double>(row) * profile.row_m;
+        if (centre_m > judging.strip_to_m + 1e-9) break;
+        const bool covered = row >= 0 && static_cast<std::size_t>(row) < rows &&
+                             (sprayed(profile.first_pass, static_cast<std::size_t>(row)) ||
+                              sprayed(profile.continuation, static_cast<std::size_t>(row)));
+        if (!covered) {
+            missed_m += profile.row_m;
+            if (!gap_from_m) gap_from_m = centre_m - 0.5 * profile.row_m;
+        } else if (gap_from_m) {
+            result.areas.push_back({"missed", *gap_from_m, centre_m - 0.5 * profile.row_m});
+            gap_from_m.reset();
         }
     }
-    result.metrics["overlap_m"] = overlap_m;
-    result.metrics["missed_m"] = missed_m;
+    if (gap_from_m) result.areas.push_back({"missed", *gap_from_m, judging.strip_to_m});
+    metrics.values["overlap_m"] = overlap_m;
+    metrics.values["missed_m"] = missed_m;
+    metrics.values["strip_length_m"] = judging.strip_to_m - judging.strip_from_m;
 
     // Areas for the CV: the repeated one where both passes sprayed; if there is
     // none, the boundary between the passes stands in for it.
@@ -159,8 +400,8 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
         repeated_from_m = profile.row_centre_m(*first_both) - 0.5 * profile.row_m;
         repeated_to_m = profile.row_centre_m(*last_both) + 0.5 * profile.row_m;
         result.areas.push_back({"repeated", repeated_from_m, repeated_to_m});
-        result.metrics["repeated_from_m"] = repeated_from_m - breakpoint_along_m;
-        result.metrics["repeated_to_m"] = repeated_to_m - breakpoint_along_m;
+        metrics.values["repeated_from_m"] = repeated_from_m - breakpoint_along_m;
+        metrics.values["repeated_to_m"] = repeated_to_m - breakpoint_along_m;
     }
     // The operational and continuation areas reach cv_window_m either side, but
     // never past the first or last sprayed row: a case that ends its pass inside
@@ -177,15 +418,15 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
         return coefficient_of_variation_pct(cv_rows(profile, total, from_m, to_m, judging.cv_row_m));
     };
     if (const double value = cv(operational_from_m, repeated_from_m); std::isfinite(value)) {
-        result.metrics["cv_operational_pct"] = value;
+        metrics.values["cv_operational_pct"] = value;
     }
     if (first_both) {
         if (const double value = cv(repeated_from_m, repeated_to_m); std::isfinite(value)) {
-            result.metrics["cv_repeated_pct"] = value;
+            metrics.values["cv_repeated_pct"] = value;
         }
     }
     if (const double value = cv(repeated_to_m, continuation_to_m); std::isfinite(value)) {
-        result.metrics["cv_continuation_pct"] = value;
+        metrics.values["cv_continuation_pct"] = value;
     }
     return result;
 }

@@ -1,58 +1,161 @@
 #pragma once
-// Metrics computed from truth (DESIGN.md "What the harness measures"). Only the
-// harness computes metrics; the controller never sees truth. Each family is a
-// pure function of plain data, so tests can hand it a truth trace with a known
-// answer; harness/case_runner.cpp extracts that data from the recorded trace
-// and the plant.
+// Metrics computed from truth (docs/metrics.md defines each one, with the
+// paper's equation or table). Only the harness computes metrics; the controller
+// never sees truth. Every family is a pure function of plain data read from the
+// recorded trace (harness/judge.h), so a run is judged the same live and by
+// `rig judge`, and tests hand them hand-made data with a known answer.
+//
+// A limited metric is either a number, or "not measured" with the reason the
+// controller's behaviour gave (the flow never settled, the breakpoint was never
+// declared): that fails its limit like a bad number does, and a faulty-controller
+// case may expect it. Only a metric the harness did not try to measure is "missing".
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "emulators/plant.h"
-#include "harness/trace_recorder.h"
+#include "emulators/field_frame.h"
 #include "rig/clock.h"
 
 namespace rig::harness {
 
+struct MetricSet {
+    std::map<std::string, double> values;
+    // Metric -> why the run gave no value for it ("never settled: ...").
+    std::map<std::string, std::string> not_measured;
+    void merge(const MetricSet& other);
+};
+
+// ---------------------------------------------------------------- vehicle truth along the track
+
+struct VehicleSample {
+    TimeNs t_ns = 0;
+    double nozzle_line_along_m = 0.0;
+    int pass_index = 0;
+};
+
+// The recorded truth/vehicle samples (20 Hz, plus one at every instant the
+// controller published). Where the nozzle line was at t: the sample at t when
+// there is one, else linear between the neighbours (the plant moves with bounded
+// acceleration: 0.16 mm error at most at 0.5 m/s^2 over 50 ms), never across a
+// headland turn (a change of pass_index): then the sample on t's side of it.
+class VehicleTrack {
+public:
+    explicit VehicleTrack(std::vector<VehicleSample> samples);  // any order; sorted here
+    bool empty() const { return samples_.empty(); }
+    std::optional<double> nozzle_line_along_m(TimeNs t) const;
+    // The first pass_index's first sample time (e.g. when pass 1 began); nullopt if never.
+    std::optional<TimeNs> pass_start_ns(int pass_index) const;
+
+private:
+    std::vector<VehicleSample> samples_;
+};
+
 // ---------------------------------------------------------------- breakpoint identification
 
+struct BreakpointEventSample {
+    TimeNs t_ns = 0;                       // when the controller's event arrived (its decision instant in lockstep)
+    std::string kind;                      // stored | reached | cleared | spray_resumed
+    std::optional<double> lat_deg, lon_deg;  // the stored breakpoint, when the wire carries it
+};
+
 // Breakpoint identification (seed 000 sec. 2.5.1, Tables 3-4):
-//   breakpoint_error_m         |nozzle line - true breakpoint| when the controller
-//                              declares "reached" (the paper's distance from the mark)
+//   breakpoint_error_m         |nozzle line - true breakpoint| at the first "reached"
 //   breakpoint_error_signed_m  + = declared after the nozzle line passed it
-//   breakpoint_store_error_m   how far the stored breakpoint lies from the true one
+//   breakpoint_reached_at_s    when
+//   breakpoint_store_error_m   distance of the first stored position from the true breakpoint
 //   breakpoint_reached_count   number of "reached" events (1 expected)
-// A metric the run could not produce (no "reached" event) is absent: the judge
-// then reports it as missing, which fails a limit on it.
-std::map<std::string, double> breakpoint_metrics(const TraceRecorder& trace, const emulators::Plant& plant,
-                                                 double breakpoint_along_m);
+// With no "reached" event, breakpoint_error_m is not measured ("never declared").
+MetricSet breakpoint_metrics(const std::vector<BreakpointEventSample>& events, const VehicleTrack& track,
+                             const emulators::FieldFrame& field, double breakpoint_along_m);
 
 // ---------------------------------------------------------------- flow control
 
-struct MainFlowSample {
+struct HydraulicsSample {
     TimeNs t_ns = 0;
-    double main_flow_l_min = 0.0;  // truth
+    double main_flow_l_min = 0.0;         // truth
+    std::uint16_t sections_spraying_mask = 0;  // section valves physically open
 };
 
-// The regulation episode to judge: from the section-open command to the next
-// close command (or the end of the run).
-struct FlowEpisode {
-    TimeNs open_command_ns = 0;
-    TimeNs end_ns = 0;
+struct SectionCommand {
+    TimeNs t_ns = 0;
+    std::uint16_t open_mask = 0;
 };
 
-// DESIGN.md: flow adjust time = from the section-valve open command until the
-// main flow enters +-band_pct of the target and stays there (to the episode's
-// end); flow error = mean |Q - target| / target after settling. When the flow
-// never settles, flow_adjust_time_s is the episode's length (a lower bound, over
-// any sane limit) and the error is taken after open + never_settled_after_s.
-//   flow_adjust_time_s, flow_error_pct, flow_mean_l_min (after settling),
-//   flow_settled (1 or 0)
-std::map<std::string, double> flow_metrics(const std::vector<MainFlowSample>& samples, const FlowEpisode& episode,
-                                           double target_l_min, double band_pct = 3.0,
-                                           double never_settled_after_s = 1.7);
+// The flow the controller's KF11 reported, by Eq. 3 on the recorded pulse counts.
+struct FlowReading {
+    TimeNs t_ns = 0;
+    double flow_l_min = 0.0;
+};
+
+struct FlowMeterCountSample {
+    TimeNs t_ns = 0;
+    std::uint32_t count_pulses = 0;
+    std::uint32_t last_edge_capture_us = 0;
+};
+
+// Eq. 3, Q = 60 w / (k t2) L/min, on the meter's own samples: w pulses between
+// the last edge and the earliest edge at least window_s before it, t2 measured
+// edge to edge with the capture timer (both counters wrap: unsigned differences).
+// What a controller reading this meter with the nameplate k computes.
+std::vector<FlowReading> kf11_readings(const std::vector<FlowMeterCountSample>& samples, double pulses_per_l,
+                                       double window_s = 0.25);
+
+// The judged window (docs/metrics.md "flow"): from the first section opening at
+// or after from_ns (the continuation pass's start; the static test's switch-on)
+// to to_ns (the route reaching the strip's end; the switch going off), exclusive.
+struct FlowWindow {
+    TimeNs from_ns = 0;
+    TimeNs to_ns = 0;
+};
+
+struct FlowJudging {
+    double target_l_min = 20.0;
+    double band_pct = 3.0;  // seed 000 sec. 3.1.2: "adjusted" = within +-3 % of the target
+    // The flow is due to be steady this long after the nozzles start (the adjust
+    // time's limit, 1.7 s by default): a flow not settled by then has its error
+    // measured from then on.
+    double settle_by_s = 1.7;
+};
+
+struct FlowResult {
+    MetricSet metrics;
+    std::optional<TimeNs> first_open_ns;  // the first opening in the window (Fig. 14's adjustment start)
+};
+
+// Seed 000 Table 2 / sec. 3.1.2 and Table 5, from truth:
+//   flow_adjust_time_s              judged: from the nozzles starting to spray
+//                                   (section valves physically open) to the start of
+//                                   the final stretch inside the band that lasts to
+//                                   the window's end; every restart of the nozzles
+//                                   (all valves shut, then open) starts it again
+//   flow_adjust_time_from_command_s the same from the open command
+//   flow_settled                    1 / 0
+//   flow_error_pct                  judged: mean |Q - target| / target from the
+//                                   flow settling, or from settle_by_s after the
+//                                   nozzles first started if it had not settled by
+//                                   then (whatever it did once it was due to be steady)
+//   flow_mean_l_min                 mean Q after settling
+//   flow_error_kf11_signed_pct      the paper's way (Table 5): signed mean of the
+//                                   KF11 readings from the nozzles starting to the
+//                                   window's end, against the target (not judged)
+//   flow_error_kf11_settled_signed_pct  the same over the settled stretch only
+// A flow that never settles leaves the adjust times not measured, with the
+// reason: never a small number. Sections that never open leave flow_error_pct
+// not measured too.
+FlowResult flow_metrics(const std::vector<HydraulicsSample>& hydraulics, const std::vector<SectionCommand>& commands,
+                        const std::vector<FlowReading>& kf11, const FlowWindow& window, const FlowJudging& judging);
+
+// Table 1 from truth: the first section-open command -> valves open
+// (section_valve_open_delay_s) -> first droplets land (spray_landing_delay_s).
+struct LandingEdgeSample {
+    TimeNs t_ns = 0;
+    bool landing = false;
+};
+MetricSet spray_timing_metrics(const std::vector<SectionCommand>& commands,
+                               const std::vector<HydraulicsSample>& hydraulics,
+                               const std::vector<LandingEdgeSample>& landing_edges);
 
 // ---------------------------------------------------------------- deposition
 
@@ -71,6 +174,9 @@ struct DepositionJudging {
     double sprayed_fraction = 0.5;      // a row is sprayed at or above this share of nominal
     double cv_row_m = 0.3;              // rows of Eq. 10-12
     double cv_window_m = 6.0;
+    // The strip the case says must be sprayed (from its route): [from, to] along the line.
+    double strip_from_m = 0.0;
+    double strip_to_m = 0.0;
 };
 
 // A stretch of the track, for the CV areas and the report's shading.
@@ -81,16 +187,18 @@ struct AreaSpan {
 };
 
 struct DepositionResult {
-    std::map<std::string, double> metrics;
+    MetricSet metrics;
     std::vector<AreaSpan> areas;
 };
 
-// overlap_m: along-track length sprayed by both passes; missed_m: length between
-// the first and the last sprayed row sprayed by neither. cv_*_pct: Eq. 10-12 over
-// the operational area (first pass only, up to cv_window_m before the repeated
-// one), the repeated area, and the continuation area (second pass only, cv_window_m
-// after it), the outer two cut at the first and last sprayed row;
-// repeated_from_m / repeated_to_m relative to the breakpoint.
+// overlap_m: along-track length sprayed by both passes; missed_m: length of the
+// strip that must be sprayed (judging.strip_*) sprayed by neither: nothing
+// sprayed after the breakpoint makes the rest of the strip missed, nothing
+// sprayed at all the whole strip. cv_*_pct: Eq. 10-12 over the operational area
+// (first pass only, up to cv_window_m before the repeated one), the repeated
+// area, and the continuation area (second pass only, cv_window_m after it), the
+// outer two cut at the first and last sprayed row; repeated_from_m /
+// repeated_to_m relative to the breakpoint.
 DepositionResult deposition_metrics(const DoseProfile& profile, const DepositionJudging& judging,
                                     double breakpoint_along_m);
 

@@ -223,7 +223,6 @@ TableRow make_row(const CaseResult& result, std::size_t metric_name_width) {
                                       : format_against(metric->second, limit, 4);
         row.metric_lines.push_back(pad_right(name, metric_name_width) + ' ' + value + " / " + format_g(limit, 6));
     }
-    if (!result.error.empty()) row.failure_lines.push_back("error: " + result.error);
     const bool expected = case_passed(result) && result.expected_failure;
     for (const std::string& failure : result.failures) {
         row.failure_lines.push_back(expected ? failure + " (expected)" : failure);
@@ -275,11 +274,21 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 
 std::vector<std::string> judge(const std::map<std::string, double>& metrics,
                                const std::map<std::string, double>& limits) {
+    return judge(metrics, {}, limits);
+}
+
+std::vector<std::string> judge(const std::map<std::string, double>& metrics,
+                               const std::map<std::string, std::string>& not_measured,
+                               const std::map<std::string, double>& limits) {
     std::vector<std::string> failures;
     for (const auto& [name, limit] : limits) {
         const auto metric = metrics.find(name);
         if (metric == metrics.end() || std::isnan(metric->second)) {
-            failures.push_back(name + std::string(kMissingSuffix));
+            if (const auto why = not_measured.find(name); why != not_measured.end()) {
+                failures.push_back(name + " not measured: " + why->second);
+            } else {
+                failures.push_back(name + std::string(kMissingSuffix));
+            }
         } else if (std::isnan(limit)) {
             // Case files cannot say this; a harness bug must not pass silently.
             failures.push_back(name + ' ' + format_g(metric->second, 6) + " > nan (limit is not a number)");
@@ -334,7 +343,45 @@ CaseVerdict judge_case(const std::map<std::string, double>& metrics, const std::
     return verdict;
 }
 
-bool case_passed(const CaseResult& result) { return result.passed && result.error.empty(); }
+CaseVerdict judge_case(const VerdictInputs& inputs) {
+    if (inputs.error_kind.empty()) {
+        CaseVerdict verdict;
+        if (!inputs.expect_error.empty()) {
+            verdict.expected_failure = true;
+            verdict.failures = judge(inputs.metrics, inputs.not_measured, inputs.limits);
+            verdict.failures.push_back("expected the run to end in " + inputs.expect_error +
+                                       ", but it ran to its end");
+            verdict.passed = false;
+            return verdict;
+        }
+        const bool expects_breaks = !inputs.expect_fail.empty();
+        verdict.expected_failure = expects_breaks;
+        verdict.failures = judge(inputs.metrics, inputs.not_measured, inputs.limits);
+        verdict.passed = passes_with_expectation(verdict.failures, inputs.expect_fail);
+        if (expects_breaks && !verdict.passed) {
+            for (std::string& reason : unmet_expectations(verdict.failures, inputs.expect_fail)) {
+                if (reason.starts_with("expected ")) verdict.failures.push_back(std::move(reason));
+            }
+        }
+        return verdict;
+    }
+    CaseVerdict verdict;
+    verdict.expected_failure = !inputs.expect_error.empty();
+    verdict.failures.push_back("error: " + inputs.error_kind + ": " + inputs.error);
+    if (inputs.expect_error == inputs.error_kind) {
+        verdict.passed = true;
+    } else if (!inputs.expect_error.empty()) {
+        verdict.failures.push_back("expected the run to end in " + inputs.expect_error + ", got " + inputs.error_kind);
+    }
+    return verdict;
+}
+
+bool case_passed(const CaseResult& result) {
+    // An error fails a case, unless the case exists to show that exact error.
+    if (!result.error.empty()) return result.passed && !result.expected_error.empty() &&
+                                      result.expected_error == result.error_kind;
+    return result.passed;
+}
 
 RunSummary summarize(const std::vector<CaseResult>& results) {
     RunSummary summary;
@@ -361,16 +408,21 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
         for (const auto& [name, value] : result.limits) limits[valid_utf8(name)] = value;
         nlohmann::json failures = nlohmann::json::array();
         for (const std::string& failure : result.failures) failures.push_back(valid_utf8(failure));
+        nlohmann::json not_measured = nlohmann::json::object();
+        for (const auto& [name, why] : result.not_measured) not_measured[valid_utf8(name)] = valid_utf8(why);
         nlohmann::json one_case = {
             {"name", valid_utf8(result.name)},
             {"file", valid_utf8(result.file)},
             {"passed", case_passed(result)},
             {"expected_failure", result.expected_failure},
+            {"expected_error", result.expected_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(result.expected_error)},
             {"seed", result.seed},
             {"metrics", std::move(metrics)},
+            {"not_measured", std::move(not_measured)},
             {"limits", std::move(limits)},
             {"failures", std::move(failures)},
             {"error", result.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(valid_utf8(result.error))},
+            {"error_kind", result.error_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(result.error_kind)},
             {"trace_sha256", valid_utf8(result.trace_sha256)},
             {"trace_path", valid_utf8(result.trace_path)},
             {"sim_seconds", result.sim_seconds},
@@ -411,9 +463,10 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
     int failures = 0;
     int errors = 0;
     for (const CaseResult& result : results) {
+        if (case_passed(result)) continue;
         if (!result.error.empty()) {
             ++errors;
-        } else if (!case_passed(result)) {
+        } else {
             ++failures;
         }
     }
@@ -427,8 +480,9 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
     for (const CaseResult& result : results) {
         xml += "    <testcase classname=\"rig\" name=\"" + xml_escape(result.name, true) + "\" file=\"" +
                xml_escape(result.file, true) + "\" time=\"" + format_fixed(result.wall_seconds, 3) + "\">\n";
-        if (!result.error.empty()) {
-            xml += "      <error type=\"error\" message=\"" + xml_escape(result.error, true) + "\">" +
+        if (!result.error.empty() && !case_passed(result)) {
+            xml += "      <error type=\"" + xml_escape(result.error_kind.empty() ? "error" : result.error_kind, true) +
+                   "\" message=\"" + xml_escape(result.error, true) + "\">" +
                    xml_escape(result.error + "\n" + join_lines(result.failures), false) + "</error>\n";
         } else if (!case_passed(result)) {
             const std::string headline =
@@ -503,7 +557,8 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
         if (!result.trace_path.empty() || !result.trace_sha256.empty()) {
             report += "trace: " + result.trace_path + "   sha256: " + result.trace_sha256 + "\n";
         }
-        if (!result.error.empty()) report += "error: " + result.error + "\n";
+        if (!result.error.empty()) report += "error (" + result.error_kind + "): " + result.error + "\n";
+        for (const auto& [name, why] : result.not_measured) report += "not measured: " + name + ": " + why + "\n";
         if (!result.metrics.empty()) {
             report += "metrics:\n";
             for (const auto& [name, value] : result.metrics) {

@@ -30,9 +30,14 @@ struct CaseResult {
     bool expected_failure = false;  // the case has expect.fail (a negative case)
     std::uint64_t seed = 1;
     std::map<std::string, double> metrics;
+    // Metrics the run gave no value for because of what the controller did, with
+    // why ("never settled: ..."); a limit on one of them is broken (docs/metrics.md).
+    std::map<std::string, std::string> not_measured;
     std::map<std::string, double> limits;  // effective limits the case was judged against
     std::vector<std::string> failures;     // e.g. "overlap_m 3.61 > 3.3"
-    std::string error;  // non-empty: the case did not run to the end (node died, bad config...); always a failure
+    std::string error;  // non-empty: the case did not run to the end (node died, bad config...)
+    std::string error_kind;      // rig::FailureKind name of the error ("node_exited", ...)
+    std::string expected_error;  // the case's expect.error: this error is the verdict it wants
     std::string trace_sha256;
     std::string trace_path;
     double sim_seconds = 0.0;
@@ -60,6 +65,12 @@ struct RunSummary {
 // that value and limit differ on screen. Unlimited metrics are never failures.
 std::vector<std::string> judge(const std::map<std::string, double>& metrics,
                                const std::map<std::string, double>& limits);
+// The same, where a limited metric in `not_measured` fails as
+// "flow_adjust_time_s not measured: never settled ..." (a break a case may
+// expect) instead of "missing" (the harness did not measure it).
+std::vector<std::string> judge(const std::map<std::string, double>& metrics,
+                               const std::map<std::string, std::string>& not_measured,
+                               const std::map<std::string, double>& limits);
 
 // Without expectations: passes when nothing failed. With expect.fail: passes
 // only when exactly those metrics broke their limits (a missing metric never
@@ -78,6 +89,21 @@ struct CaseVerdict {
 };
 CaseVerdict judge_case(const std::map<std::string, double>& metrics, const std::map<std::string, double>& limits,
                        const std::vector<std::string>& expect_fail);
+
+// The whole verdict of a case: metrics (with what was not measured) against
+// limits and expect.fail when the run went to its end; when it ended in an
+// error, only whether that error is the one expect.error names. An errored
+// case's metrics (from its partial trace) are reported, never judged.
+struct VerdictInputs {
+    std::map<std::string, double> metrics;
+    std::map<std::string, std::string> not_measured;
+    std::map<std::string, double> limits;
+    std::vector<std::string> expect_fail;
+    std::string expect_error;  // FailureKind name, or empty
+    std::string error_kind;    // of the run, or empty when it went to its end
+    std::string error;         // its text
+};
+CaseVerdict judge_case(const VerdictInputs& inputs);
 
 // A case counts as passed only when `passed` is set and there is no error.
 bool case_passed(const CaseResult& result);

@@ -1,64 +1,67 @@
 #pragma once
-// Records every topic of a run to one SQLite file per case (open it with
-// `sqlite3 trace.sqlite`, or any SQLite browser): table `samples(t_ns, round,
-// topic, json)` in the exact order the lockstep rounds delivered them, plus
-// per-topic views and a `meta` table. The SHA-256 of the canonical rows
-// ("t_ns round topic json\n") is the case's trace_sha256: same case + same seed
-// => same digest, bit for bit.
-#include <cstdint>
-#include <filesystem>
+// Records every topic of a run into its trace file (harness/trace_file.h), in
+// the exact order the lockstep rounds delivered them. Besides what arrives:
+//   - truth/vehicle also gets the plant's state at every instant a controller
+//     output (actuator/*, controller/*) arrived, so each thing the controller did
+//     has its exact truth beside it and the judge needs no plant;
+//   - a sample on a truth/* or device/* topic written by a participant other
+//     than the rig is forged: it goes to foreign_samples, never into samples.
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "emulators/deposition_grid.h"
-#include "rig/clock.h"
+#include "harness/trace_file.h"
 #include "rig/dds_context.h"
 
-struct sqlite3;
-struct sqlite3_stmt;
-struct evp_md_ctx_st;
-
 namespace rig::harness {
+
+// A sample on a truth or device topic that another participant wrote.
+struct ForeignSample {
+    TimeNs t_ns = 0;
+    std::string topic;
+    std::string participant;
+    std::string guid_prefix;
+};
 
 class TraceRecorder {
 public:
     TraceRecorder(DdsContext& dds, const std::filesystem::path& file);
-    ~TraceRecorder();
     TraceRecorder(const TraceRecorder&) = delete;
     TraceRecorder& operator=(const TraceRecorder&) = delete;
 
-    void set_meta(const std::string& key, const std::string& value);
+    TraceFile& file() { return file_; }
+    // The plant's vehicle truth at any instant (a pure function of t).
+    void set_vehicle_truth_probe(std::function<msg::VehicleTruth(TimeNs)> probe) { probe_ = std::move(probe); }
     // Takes every sample that arrived and records it at (t, round).
     void drain(TimeNs t, int round);
-    // Writes the plant's deposition grid (table `deposition`); part of the digest.
-    void record_deposition(const emulators::DepositionGrid& grid);
-    // Commits and closes the file; returns the hex SHA-256 of the trace.
-    std::string finish();
-
-    // Every sample recorded so far, by topic, for metric computation: (t, json).
-    const std::vector<std::pair<TimeNs, nlohmann::json>>& samples(const std::string& topic) const;
+    // Samples other participants wrote on rig-only topics, so far.
+    const std::vector<ForeignSample>& foreign_samples() const { return foreign_; }
 
 private:
     struct Channel {
         std::string topic;
-        std::function<std::vector<nlohmann::json>()> take;
+        // Appends (json, writer's GUID prefix) of every sample taken.
+        std::function<void(std::vector<std::pair<nlohmann::json, std::string>>&)> take;
     };
     template <class Msg>
     void add_channel(DdsContext& dds, const char* topic);
-    void append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json);
 
+    DdsContext& dds_;
+    TraceFile file_;
     std::vector<Channel> channels_;  // drained in this fixed order
     std::vector<std::shared_ptr<void>> readers_;
-    std::map<std::string, std::vector<std::pair<TimeNs, nlohmann::json>>> by_topic_;
-    sqlite3* db_ = nullptr;
-    sqlite3_stmt* insert_ = nullptr;
-    evp_md_ctx_st* digest_ = nullptr;
-    std::string sha256_;
+    std::function<msg::VehicleTruth(TimeNs)> probe_;
+    TimeNs last_vehicle_truth_ns_ = -1;
+    std::vector<ForeignSample> foreign_;
 };
+
+// Topics only the rig may write (truth and device data). A sample on one of
+// them from another participant is forged.
+bool rig_only_topic(const std::string& topic);
+// Topics the controller under test writes (actuator commands, its own reports).
+bool controller_output_topic(const std::string& topic);
 
 }  // namespace rig::harness

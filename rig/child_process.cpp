@@ -26,11 +26,19 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
 
+    // Its own process group: a Ctrl-C at the terminal reaches the rig alone, which
+    // then ends the run and stops this process itself (and records why).
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);
+
     std::vector<char*> raw_argv;
     for (const auto& arg : argv) raw_argv.push_back(const_cast<char*>(arg.c_str()));
     raw_argv.push_back(nullptr);
-    const int rc = posix_spawnp(&pid_, raw_argv[0], &actions, nullptr, raw_argv.data(), environ);
+    const int rc = posix_spawnp(&pid_, raw_argv[0], &actions, &attributes, raw_argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attributes);
     if (rc != 0) {
         throw std::runtime_error("cannot start '" + command_line_ + "': " + std::strerror(rc));
     }

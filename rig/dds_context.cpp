@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
@@ -98,11 +99,35 @@ bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
     return reader_->wait_for_unread_message(limit);
 }
 
-bool ReaderBase::take_raw(void* sample) {
+namespace {
+
+std::string hex_prefix(const unsigned char* bytes, std::size_t size) {
+    static const char* digits = "0123456789abcdef";
+    std::string hex;
+    for (std::size_t i = 0; i < size; ++i) {
+        hex += digits[bytes[i] >> 4];
+        hex += digits[bytes[i] & 0xf];
+    }
+    return hex;
+}
+
+std::string prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+    return hex_prefix(prefix.value, eprosima::fastrtps::rtps::GuidPrefix_t::size);
+}
+
+}  // namespace
+
+bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
     dds::SampleInfo info;
     while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) {
             taken_.fetch_add(1);
+            if (writer_prefix != nullptr) {
+                // The publication handle is the writer's GUID: its first 12 bytes are its participant's prefix.
+                unsigned char bytes[eprosima::fastrtps::rtps::GuidPrefix_t::size];
+                for (std::size_t i = 0; i < sizeof bytes; ++i) bytes[i] = info.publication_handle.value[i];
+                *writer_prefix = hex_prefix(bytes, sizeof bytes);
+            }
             return true;
         }
         // Dispose / unregister notifications are not samples; nobody writes them here.
@@ -117,8 +142,44 @@ std::uint64_t ReaderBase::received_count() const {
     return taken_.load() + unread;
 }
 
-DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name) : domain_id_(domain_id) {
-    participant_ = create_loopback_participant(domain_id, participant_name);
+// Discovery callbacks arrive on Fast DDS's threads; they only append under a lock.
+class DdsContext::DiscoveryWatch final : public dds::DomainParticipantListener {
+public:
+    void on_participant_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_PARTICIPANT && info.status != Status::CHANGED_QOS_PARTICIPANT) return;
+        std::lock_guard lock(mutex);
+        names[prefix_of(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
+    }
+    void on_subscriber_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_READER && info.status != Status::REMOVED_READER) return;
+        add(prefix_of(info.info.guid().guidPrefix), info.info.topicName().to_string(), info.info.typeName().to_string(),
+            false, info.status == Status::REMOVED_READER);
+    }
+    void on_publisher_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_WRITER && info.status != Status::REMOVED_WRITER) return;
+        add(prefix_of(info.info.guid().guidPrefix), info.info.topicName().to_string(), info.info.typeName().to_string(),
+            true, info.status == Status::REMOVED_WRITER);
+    }
+    void add(std::string prefix, std::string topic, std::string type, bool writer, bool removed) {
+        std::lock_guard lock(mutex);
+        const auto name = names.find(prefix);
+        pending.push_back(DiscoveredEndpoint{name == names.end() ? "?" : name->second, std::move(prefix),
+                                             std::move(topic), std::move(type), writer, removed});
+    }
+
+    mutable std::mutex mutex;
+    std::map<std::string, std::string> names;  // GUID prefix -> participant name
+    std::vector<DiscoveredEndpoint> pending;
+};
+
+DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery)
+    : domain_id_(domain_id) {
+    if (watch_discovery) discovery_ = std::make_unique<DiscoveryWatch>();
+    participant_ = create_loopback_participant(domain_id, participant_name, discovery_.get());
+    guid_prefix_ = prefix_of(participant_->guid().guidPrefix);
     publisher_ = participant_->create_publisher(participant_->get_default_publisher_qos());
     subscriber_ = participant_->create_subscriber(participant_->get_default_subscriber_qos());
     if (publisher_ == nullptr || subscriber_ == nullptr) {
@@ -142,6 +203,38 @@ dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*ma
     if (topic == nullptr) throw std::runtime_error("cannot create DDS topic " + name + " of type " + type_name);
     topics_.emplace(name, topic);
     return topic;
+}
+
+std::vector<DiscoveredEndpoint> DdsContext::take_discoveries() {
+    std::vector<DiscoveredEndpoint> taken;
+    if (!discovery_) return taken;
+    std::lock_guard lock(discovery_->mutex);
+    for (DiscoveredEndpoint& endpoint : discovery_->pending) {
+        if (same_process(endpoint.guid_prefix)) continue;  // the rig's own endpoints
+        // A participant's name may have been announced after its first endpoint.
+        if (endpoint.participant == "?") {
+            if (const auto name = discovery_->names.find(endpoint.guid_prefix); name != discovery_->names.end()) {
+                endpoint.participant = name->second;
+            }
+        }
+        taken.push_back(std::move(endpoint));
+    }
+    discovery_->pending.clear();
+    return taken;
+}
+
+bool DdsContext::same_process(const std::string& guid_prefix) const {
+    // Fast DDS prefixes: 2 bytes vendor, 2 bytes host, 4 bytes process, 4 bytes participant.
+    constexpr std::size_t kProcessHexDigits = 16;
+    return guid_prefix.compare(0, kProcessHexDigits, guid_prefix_, 0, kProcessHexDigits) == 0;
+}
+
+std::string DdsContext::participant_name(const std::string& guid_prefix) const {
+    if (guid_prefix == guid_prefix_) return participant_->get_qos().name().to_string();
+    if (!discovery_) return "?";
+    std::lock_guard lock(discovery_->mutex);
+    const auto name = discovery_->names.find(guid_prefix);
+    return name == discovery_->names.end() ? "?" : name->second;
 }
 
 std::map<std::string, std::uint64_t> DdsContext::written_counts() const {

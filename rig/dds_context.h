@@ -33,6 +33,18 @@ namespace dds = eprosima::fastdds::dds;
 
 class DdsContext;
 
+// An endpoint of another participant on the domain, as discovery reported it
+// (rig/dds_context.cpp). The harness judges roles from these, not from what a
+// node says about itself in its hello.
+struct DiscoveredEndpoint {
+    std::string participant;  // the name the participant announced ("?" if its announcement came later)
+    std::string guid_prefix;  // the participant's GUID prefix in hex: two participants of one name differ here
+    std::string topic;
+    std::string type;
+    bool writer = false;      // false: a reader
+    bool removed = false;     // the endpoint went away
+};
+
 // Endpoint-independent part of a writer, so the context can wait for all of them.
 class WriterBase {
 public:
@@ -99,8 +111,9 @@ public:
 
 protected:
     ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic);
-    // Takes one sample into `sample`; false when the history is empty.
-    bool take_raw(void* sample);
+    // Takes one sample into `sample`; false when the history is empty. With
+    // `writer_prefix`, also says whose participant wrote it (hex GUID prefix).
+    bool take_raw(void* sample, std::string* writer_prefix = nullptr);
 
 private:
     struct MatchListener : dds::DataReaderListener {
@@ -131,16 +144,37 @@ public:
         while (take_raw(&sample)) samples.push_back(sample);
         return samples;
     }
+    // The same, each with the GUID prefix (hex) of the participant that wrote it.
+    std::vector<std::pair<Msg, std::string>> take_all_with_writer() {
+        std::vector<std::pair<Msg, std::string>> samples;
+        Msg sample;
+        std::string writer;
+        while (take_raw(&sample, &writer)) samples.emplace_back(sample, writer);
+        return samples;
+    }
 };
 
 class DdsContext {
 public:
-    DdsContext(std::uint32_t domain_id, const std::string& participant_name);
+    // `watch_discovery`: keep every endpoint other participants create or remove
+    // on the domain, for take_discoveries() (the harness's role check).
+    DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery = false);
     ~DdsContext();
     DdsContext(const DdsContext&) = delete;
     DdsContext& operator=(const DdsContext&) = delete;
 
     std::uint32_t domain_id() const { return domain_id_; }
+    // This participant's GUID prefix (hex), as Reader::take_all_with_writer reports writers.
+    const std::string& guid_prefix() const { return guid_prefix_; }
+    // Whether a participant's GUID prefix is of this process (its first 8 bytes,
+    // vendor, host and process, are ours): the rig's own participants, whichever
+    // case or domain they serve, never count as a controller's.
+    bool same_process(const std::string& guid_prefix) const;
+    // Endpoints of participants of other processes discovered or removed since the
+    // last call, in the order discovery reported them (empty unless watch_discovery).
+    std::vector<DiscoveredEndpoint> take_discoveries();
+    // The name a participant announced, by GUID prefix ("?" when unknown).
+    std::string participant_name(const std::string& guid_prefix) const;
     dds::DomainParticipant& participant() { return *participant_; }
     dds::Publisher& publisher() { return *publisher_; }
     dds::Subscriber& subscriber() { return *subscriber_; }
@@ -187,7 +221,10 @@ public:
 private:
     dds::Topic* topic_for(const std::string& name, dds::TypeSupport (*make_type)());
 
+    class DiscoveryWatch;
     std::uint32_t domain_id_;
+    std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
+    std::string guid_prefix_;
     dds::DomainParticipant* participant_ = nullptr;
     dds::Publisher* publisher_ = nullptr;
     dds::Subscriber* subscriber_ = nullptr;

@@ -4,12 +4,20 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <stdexcept>
 
 namespace rig {
 
 DomainLease DomainLease::acquire(std::uint32_t first, std::uint32_t last) {
-    for (std::uint32_t domain = first; domain <= last; ++domain) {
+    // Round-robin from after the last domain this process took: a domain a case
+    // has just left is not reused at once, while the previous controller process
+    // may still be on its way out and discovery still remembers it.
+    static std::atomic<std::uint32_t> next{0};
+    const std::uint32_t span = last - first + 1;
+    const std::uint32_t start = next.fetch_add(1) % span;
+    for (std::uint32_t k = 0; k < span; ++k) {
+        const std::uint32_t domain = first + (start + k) % span;
         const std::string path = "/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock";
         const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
         if (fd < 0) continue;

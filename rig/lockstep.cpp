@@ -74,6 +74,42 @@ std::string format_time(TimeNs t) {
 
 }  // namespace
 
+namespace {
+constexpr std::pair<FailureKind, std::string_view> kFailureKindNames[] = {
+    {FailureKind::node_exited, "node_exited"},
+    {FailureKind::node_unresponsive, "node_unresponsive"},
+    {FailureKind::node_fatal_error, "node_fatal_error"},
+    {FailureKind::startup_timeout, "startup_timeout"},
+    {FailureKind::delivery_timeout, "delivery_timeout"},
+    {FailureKind::topic_role_violation, "topic_role_violation"},
+    {FailureKind::wire_unread, "wire_unread"},
+    {FailureKind::wall_time_exceeded, "wall_time_exceeded"},
+    {FailureKind::feedback_loop, "feedback_loop"},
+    {FailureKind::interrupted, "interrupted"},
+    {FailureKind::harness_error, "harness_error"},
+};
+}  // namespace
+
+std::string_view to_string(FailureKind kind) {
+    for (const auto& [value, name] : kFailureKindNames) {
+        if (value == kind) return name;
+    }
+    return "harness_error";
+}
+
+std::optional<FailureKind> failure_kind_from_string(std::string_view name) {
+    for (const auto& [value, known] : kFailureKindNames) {
+        if (known == name) return value;
+    }
+    return std::nullopt;
+}
+
+std::string failure_kind_names() {
+    std::string names;
+    for (const auto& [value, name] : kFailureKindNames) names += (names.empty() ? "" : ", ") + std::string(name);
+    return names;
+}
+
 LockstepMaster::LockstepMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), timeouts_(timeouts) {}
 
 LockstepMaster::~LockstepMaster() { shutdown(); }
@@ -91,13 +127,14 @@ void LockstepMaster::start() {
 
     const WallStopwatch waited;
     auto check_startup = [&](const std::string& what) {
+        if (watchdog_) watchdog_();
         for (const Remote& remote : remotes_) {
-            if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) throw NodeFailure(remote.name, *gone);
+            if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) throw NodeFailure(FailureKind::node_exited, remote.name, *gone);
         }
         if (waited.elapsed() > timeouts_.startup) {
             std::string names;
             for (const Remote& remote : remotes_) names += (names.empty() ? "" : ", ") + remote.name;
-            throw NodeFailure(names.empty() ? "harness" : names,
+            throw NodeFailure(FailureKind::startup_timeout, names.empty() ? "harness" : names,
                               what + " not done within " + std::to_string(timeouts_.startup.count()) + " ms");
         }
     };
@@ -171,7 +208,7 @@ LockstepMaster::TopicCounts LockstepMaster::reader_counts() const {
 void LockstepMaster::check_remotes_alive(TimeNs t) const {
     for (const Remote& remote : remotes_) {
         if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) {
-            throw NodeFailure(remote.name, *gone + " (at t=" + format_time(t) + ")");
+            throw NodeFailure(FailureKind::node_exited, remote.name, *gone + " (at t=" + format_time(t) + ")");
         }
     }
 }
@@ -183,15 +220,16 @@ void LockstepMaster::wait_local_readers(TimeNs t) {
     for (;;) {
         const auto short_topics = dds_.wait_received(expected, kPollSlice);
         if (short_topics.empty()) return;
+        if (watchdog_) watchdog_();
         for (const Remote& remote : remotes_) {
             if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) {
-                throw NodeFailure(remote.name, *gone + " (at t=" + format_time(t) + ")");
+                throw NodeFailure(FailureKind::node_exited, remote.name, *gone + " (at t=" + format_time(t) + ")");
             }
         }
         if (waited.elapsed() > timeouts_.delivery) {
             std::string writers;
             for (const Remote& remote : remotes_) writers += (writers.empty() ? "" : ", ") + remote.name;
-            throw NodeFailure(writers.empty() ? "harness" : writers,
+            throw NodeFailure(FailureKind::delivery_timeout, writers.empty() ? "harness" : writers,
                               "samples on " + join(short_topics) + " did not arrive at the harness at t=" +
                                   format_time(t) + " within " + std::to_string(timeouts_.delivery.count()) + " ms");
         }
@@ -220,7 +258,7 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
             if (ack.seq() != seq) continue;  // a late answer to an older tick
             for (std::size_t i = 0; i < remotes_.size(); ++i) {
                 if (answered[i] || remotes_[i].name != ack.node_name().to_string()) continue;
-                if (ack.fatal_error().size() > 0) throw NodeFailure(remotes_[i].name, ack.fatal_error().to_string());
+                if (ack.fatal_error().size() > 0) throw NodeFailure(FailureKind::node_fatal_error, remotes_[i].name, ack.fatal_error().to_string());
                 answered[i] = true;
                 --outstanding;
                 remotes_[i].next_wake_ns = ack.next_wake_ns();
@@ -233,14 +271,15 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
             }
         }
         if (outstanding == 0) break;
+        if (watchdog_ && !shutdown) watchdog_();
         for (std::size_t i = 0; i < remotes_.size(); ++i) {
             if (answered[i]) continue;
             if (auto gone = remotes_[i].liveness ? remotes_[i].liveness() : std::nullopt) {
-                throw NodeFailure(remotes_[i].name, *gone + " (waiting for tick " + std::to_string(seq) +
+                throw NodeFailure(FailureKind::node_exited, remotes_[i].name, *gone + " (waiting for tick " + std::to_string(seq) +
                                                         " at t=" + format_time(t) + ")");
             }
             if (waited.elapsed() > limit) {
-                throw NodeFailure(remotes_[i].name, "did not acknowledge " +
+                throw NodeFailure(FailureKind::node_unresponsive, remotes_[i].name, "did not acknowledge " +
                                                         std::string(shutdown ? "the shutdown tick" : "tick ") +
                                                         (shutdown ? "" : std::to_string(seq)) + " at t=" +
                                                         format_time(t) + " within " +
@@ -263,7 +302,7 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
     std::uint32_t published_by_remotes = 0;
     for (int round = 0;; ++round) {
         if (round >= kMaxRoundsPerInstant) {
-            throw NodeFailure("harness", "nodes kept answering each other at t=" + format_time(t) + " for " +
+            throw NodeFailure(FailureKind::feedback_loop, "harness", "nodes kept answering each other at t=" + format_time(t) + " for " +
                                              std::to_string(kMaxRoundsPerInstant) + " rounds (a feedback loop)");
         }
         for (Local& local : locals_) {
@@ -284,6 +323,7 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
         // here and in the remotes, before the round ends.
         wait_local_readers(t);
         if (after_round_) after_round_(t, round);
+        if (watchdog_) watchdog_();
         if (published_by_remotes == 0) {
             // Local nodes may still hold input that arrived from other local nodes.
             bool pending = false;
@@ -294,12 +334,20 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
     return t;
 }
 
-void LockstepMaster::shutdown() noexcept {
+void LockstepMaster::shutdown(bool after_failure) noexcept {
     if (shut_down_) return;
     shut_down_ = true;
     if (started_ && !remotes_.empty()) {
         try {
-            tick_remotes(now_ns_, true);
+            if (after_failure) {
+                msg::ClockTick tick;
+                tick.seq(seq_++);
+                tick.time_ns(now_ns_);
+                tick.shutdown(true);
+                tick_writer_->publish(tick);
+            } else {
+                tick_remotes(now_ns_, true);
+            }
         } catch (const std::exception& error) {
             std::cerr << "rig: during shutdown: " << error.what() << "\n";
         }

@@ -38,6 +38,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -47,14 +48,38 @@
 
 namespace rig {
 
+// Why a run could not go on. The names are part of the results contract
+// (results.json `error_kind`, a case's `expect: { error: ... }`), so a case can
+// say which failure a faulty controller must cause.
+enum class FailureKind {
+    node_exited,           // the node's process ended (crash, exit) before the run did
+    node_unresponsive,     // it did not acknowledge a tick within the bound
+    node_fatal_error,      // it reported a fatal error in its acknowledgement
+    startup_timeout,       // discovery, hello or endpoint matching not done in time
+    delivery_timeout,      // samples it published did not arrive in time
+    topic_role_violation,  // a process read or wrote a topic its role forbids (truth, device, clock)
+    wire_unread,           // a bench wire's far end never took what the rig wrote on it
+    wall_time_exceeded,    // the case ran past its wall-time bound
+    feedback_loop,         // nodes kept answering each other at one instant
+    interrupted,           // SIGINT / SIGTERM stopped the run
+    harness_error,         // the rig itself failed (a trace it cannot write, a bad wire...)
+};
+std::string_view to_string(FailureKind kind);
+// The kind with this name; nullopt for an unknown one.
+std::optional<FailureKind> failure_kind_from_string(std::string_view name);
+// Every kind, for validation messages ("one of: ...").
+std::string failure_kind_names();
+
 // A node failed: did not answer in time, died, or reported a fatal error.
 class NodeFailure : public std::runtime_error {
 public:
-    NodeFailure(std::string node_name, const std::string& what)
-        : std::runtime_error("node '" + node_name + "': " + what), node_name_(std::move(node_name)) {}
+    NodeFailure(FailureKind kind, std::string node_name, const std::string& what)
+        : std::runtime_error("node '" + node_name + "': " + what), kind_(kind), node_name_(std::move(node_name)) {}
+    FailureKind kind() const { return kind_; }
     const std::string& node_name() const { return node_name_; }
 
 private:
+    FailureKind kind_;
     std::string node_name_;
 };
 
@@ -77,6 +102,11 @@ public:
     void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
     // Called after every round with (t, round): the recorder drains its readers here.
     void set_after_round(std::function<void(TimeNs, int)> callback) { after_round_ = std::move(callback); }
+    // Called in every wall-time slice the master waits (start-up, acknowledgements,
+    // delivery) and after every round: the harness checks what no node reports
+    // (a stop signal, its wall-time bound, topic roles seen in discovery) and
+    // throws NodeFailure to end the run.
+    void set_watchdog(std::function<void()> callback) { watchdog_ = std::move(callback); }
 
     // Configure local nodes, wait for remote hellos and endpoint matching, activate.
     void start();
@@ -84,8 +114,10 @@ public:
     // next wake-up is later than until_ns (the run is over).
     std::optional<TimeNs> advance(TimeNs until_ns);
     // Sends the shutdown tick, waits (bounded) for the remotes' last acks, shuts
-    // local nodes down in reverse order. Never throws.
-    void shutdown() noexcept;
+    // local nodes down in reverse order. Never throws. After a failure
+    // (`after_failure`) the tick is sent but not waited for: a remote that died
+    // or stopped answering would only make the rig wait out its bound again.
+    void shutdown(bool after_failure = false) noexcept;
 
     std::uint64_t ticks_sent() const { return seq_; }
     // Real-time runs (rig/realtime.h) use the master for the remotes only: one
@@ -125,6 +157,7 @@ private:
     std::unique_ptr<Writer<msg::ClockTick>> tick_writer_;
     std::unique_ptr<Reader<msg::ClockAck>> ack_reader_;
     std::function<void(TimeNs, int)> after_round_;
+    std::function<void()> watchdog_;
     std::uint64_t seq_ = 0;
     TimeNs now_ns_ = 0;
     bool started_ = false;

@@ -1,11 +1,14 @@
 #include "rig/participant_factory.h"
 
 #include <cstdlib>
+#include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
 namespace rig {
 
@@ -42,15 +45,38 @@ void load_profiles_once() {
     if (!error.empty()) throw std::runtime_error(error);
 }
 
+// The participant ids this process's live participants hold.
+std::mutex ids_mutex;
+std::map<dds::DomainParticipant*, int> ids_in_use;
+
+int lowest_free_id() {
+    std::set<int> used;
+    for (const auto& [participant, id] : ids_in_use) used.insert(id);
+    int id = 0;
+    while (used.count(id)) ++id;
+    return id;
+}
+
 }  // namespace
 
-dds::DomainParticipant* create_loopback_participant(std::uint32_t domain_id,
-                                                    const std::string& participant_name) {
+dds::DomainParticipant* create_loopback_participant(std::uint32_t domain_id, const std::string& participant_name,
+                                                    dds::DomainParticipantListener* discovery_listener) {
     load_profiles_once();
-    // Straight from the profile: no QoS object built in code, so the transports and
-    // discovery settings are exactly those of loopback_profile.xml.
-    auto* participant = dds::DomainParticipantFactory::get_instance()->create_participant_with_profile(
-        static_cast<dds::DomainId_t>(domain_id), kLoopbackProfileName);
+    // The QoS comes from the profile, so the transports and discovery settings are
+    // exactly those of loopback_profile.xml; only the name is set here.
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    dds::DomainParticipantQos qos;
+    if (factory->get_participant_qos_from_profile(kLoopbackProfileName, qos) !=
+        eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+        throw std::runtime_error(std::string("cannot read DDS participant profile ") + kLoopbackProfileName);
+    }
+    qos.name(participant_name);
+    std::lock_guard lock(ids_mutex);
+    const int participant_id = lowest_free_id();
+    qos.wire_protocol().participant_id = participant_id;
+    auto* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain_id), qos, discovery_listener,
+                                                    dds::StatusMask::none());
+    if (participant != nullptr) ids_in_use[participant] = participant_id;
     if (participant == nullptr) {
         throw std::runtime_error("cannot create DDS participant '" + participant_name + "' on domain " +
                                  std::to_string(domain_id) + " from profile " + kLoopbackProfileName);
@@ -62,6 +88,8 @@ void delete_participant(dds::DomainParticipant* participant) {
     if (participant == nullptr) return;
     participant->delete_contained_entities();
     dds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    std::lock_guard lock(ids_mutex);
+    ids_in_use.erase(participant);
 }
 
 }  // namespace rig

@@ -1,5 +1,7 @@
 #include "rig/pty_pair.h"
 
+#include <sys/ioctl.h>
+
 #include <fcntl.h>
 #include <poll.h>
 #include <stdlib.h>
@@ -73,6 +75,13 @@ PtyPair::PtyPair(const PtyOptions& options) {
         make_symlink(slave_path_, options.link_path);
         link_path_ = options.link_path;
     }
+}
+
+
+std::size_t PtyPair::unread_bytes() const {
+    int queued = 0;
+    if (!held_slave_ || ::ioctl(held_slave_->native_handle(), FIONREAD, &queued) != 0 || queued < 0) return 0;
+    return static_cast<std::size_t>(queued);
 }
 
 PtyPair::~PtyPair() {

@@ -57,6 +57,10 @@ public:
     // The rig's side. Reads report SerialError::closed only if the held slave
     // was closed, i.e. never while this object lives.
     SerialPort& master() { return *master_; }
+    // Bytes written on the master that no program has read from the slave yet
+    // (FIONREAD on the held slave: every program on the slave shares its input
+    // queue). A count that never goes down means nobody reads the line.
+    std::size_t unread_bytes() const;
 
 private:
     std::string slave_path_;

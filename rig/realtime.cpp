@@ -97,6 +97,7 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
         }
         if (after_step_) after_step_(now);
         remotes_.check_remotes_alive(now);
+        if (watchdog_) watchdog_();
 
         TimeNs next = end_ns;
         bool input_pending = false;
@@ -112,10 +113,10 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
     }
 }
 
-void RealtimeMaster::shutdown() noexcept {
+void RealtimeMaster::shutdown(bool after_failure) noexcept {
     if (shut_down_) return;
     shut_down_ = true;
-    remotes_.shutdown();  // the shutdown tick; it has no local nodes to stop
+    remotes_.shutdown(after_failure);  // the shutdown tick; it has no local nodes to stop
     for (auto it = locals_.rbegin(); it != locals_.rend(); ++it) {
         try {
             it->node->shutdown();

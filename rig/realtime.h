@@ -67,6 +67,11 @@ public:
     // Called after every pass through the loop with the instant it began (the
     // trace recorder drains its readers here).
     void set_after_step(std::function<void(TimeNs)> callback) { after_step_ = std::move(callback); }
+    // As LockstepMaster::set_watchdog: called while waiting at start-up and after every pass.
+    void set_watchdog(std::function<void()> callback) {
+        watchdog_ = callback;
+        remotes_.set_watchdog(std::move(callback));
+    }
 
     // Configures the local nodes, says hello to the remotes, waits for every
     // endpoint to match, then starts every clock at t = 0.
@@ -74,8 +79,9 @@ public:
     // Runs until the clock reaches end_ns. Throws NodeFailure for a remote that
     // died and whatever a local node's step throws.
     void run_until(TimeNs end_ns);
-    // The shutdown tick to the remotes, local nodes shut down in reverse order. Never throws.
-    void shutdown() noexcept;
+    // The shutdown tick to the remotes, local nodes shut down in reverse order.
+    // Never throws. `after_failure`: as LockstepMaster::shutdown.
+    void shutdown(bool after_failure = false) noexcept;
 
     const RealtimeClock& clock() const { return clock_; }
     // Per local node (by name): how late its timed wake-ups were.
@@ -93,6 +99,7 @@ private:
     RealtimeClock clock_;
     std::vector<Local> locals_;
     std::function<void(TimeNs)> after_step_;
+    std::function<void()> watchdog_;
     bool started_ = false;
     bool shut_down_ = false;
 };

@@ -261,6 +261,29 @@ expect: { fail: [ breakpoint_error_m ] }
     EXPECT_EQ(spec.expect.fail, (std::vector<std::string>{"breakpoint_error_m"}));
 }
 
+TEST(CaseSpec, SeedsExpectedErrorsAndTheStripAllowances) {
+    const CaseSpec spec = parse_case(std::string(kMinimalCase) +
+                                         "seeds: [ 11, 3, 7 ]\nexpect: { error: topic_role_violation }\n"
+                                         "deposition: { strip_start_allowance_m: 2.5, strip_end_allowance_m: 0.5 }\n",
+                                     "seeds.yaml");
+    EXPECT_EQ(spec.seeds, (std::vector<std::uint64_t>{11, 3, 7}));
+    EXPECT_EQ(spec.seed, 11u) << "the first of the seeds";
+    EXPECT_EQ(spec.expect.error, "topic_role_violation");
+    EXPECT_EQ(spec.deposition.strip_start_allowance_m, 2.5);
+    EXPECT_EQ(spec.deposition.strip_end_allowance_m, 0.5);
+    EXPECT_FALSE(spec.source_text.empty());
+    // Allowances that leave nothing of a continuation's strip are refused.
+    try {
+        parse_case(std::string(kMinimalCase) +
+                       "scenario: breakpoint_continuation\ndeposition: { strip_start_allowance_m: 10, "
+                       "strip_end_allowance_m: 5 }\n",
+                   "strip.yaml");
+        ADD_FAILURE() << "allowances longer than the strip were accepted";
+    } catch (const rig::ConfigError& error) {
+        EXPECT_NE(std::string(error.what()).find("leave nothing of the 15 m strip"), std::string::npos) << error.what();
+    }
+}
+
 TEST(CaseSpec, HarnessCanExtendTheDefaultLimits) {
     std::map<std::string, double> defaults = kDefaultLimits;
     defaults["spray_drift_m"] = 0.5;
@@ -381,6 +404,17 @@ const std::vector<BrokenFile>& broken_files() {
          "expected a mapping"},
         {"controller command that names nothing", std::string(kMinimalCase) + "controller: { command: [] }\n",
          "8:24: controller.command:", "must name the controller executable"},
+        {"seed and seeds both", std::string(kMinimalCase) + "seed: 3\nseeds: [ 1, 2 ]\n", "9:8: seeds:",
+         "either `seed` or `seeds`"},
+        {"a seed listed twice", std::string(kMinimalCase) + "seeds: [ 1, 2, 1 ]\n", "8:16: seeds[2]:",
+         "seed 1 is listed twice"},
+        {"a seed that is not a number", std::string(kMinimalCase) + "seeds: [ 1, x ]\n", "8:13: seeds[1]:",
+         "a seed is a whole number"},
+        {"an expected error that is no kind of failure", std::string(kMinimalCase) + "expect: { error: crashed }\n",
+         "8:18: expect.error:", "'crashed' is not a kind of run failure; one of: node_exited"},
+        {"an expected error and expected metric breaks", std::string(kMinimalCase) +
+             "expect: { fail: [ breakpoint_error_m ], error: node_exited }\n",
+         "8:48: expect.error:", "cannot also expect metrics to break"},
         // yaml-cpp gives an alias the mark of the node it refers to.
         {"an alias that contains itself", std::string(kMinimalCase) + "controller: &loop { again: *loop }\n",
          "8:13: controller.again:", "an alias refers to its own ancestor"},

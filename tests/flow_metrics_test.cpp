@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <cstdint>
 #include <vector>
 
 #include "harness/metrics.h"
@@ -17,17 +18,30 @@ using rig::TimeNs;
 using rig::harness::AreaSpan;
 using rig::harness::DepositionJudging;
 using rig::harness::DoseProfile;
-using rig::harness::FlowEpisode;
-using rig::harness::MainFlowSample;
+using rig::harness::FlowJudging;
+using rig::harness::FlowReading;
+using rig::harness::FlowWindow;
+using rig::harness::HydraulicsSample;
+using rig::harness::MetricSet;
+using rig::harness::SectionCommand;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kS = 1'000'000'000;
 
-// Truth samples every 10 ms over [from, to), the flow given by `flow(t)`.
-std::vector<MainFlowSample> sampled(TimeNs from, TimeNs to, const std::function<double(TimeNs)>& flow) {
-    std::vector<MainFlowSample> samples;
-    for (TimeNs t = from; t < to; t += 10 * kMs) samples.push_back({t, flow(t)});
+// Truth samples every 10 ms over [from, to): the flow given by `flow(t)`, the
+// section valves physically open from `open_from` (Table 1: 0.2 s after the
+// command) while `open(t)`.
+std::vector<HydraulicsSample> sampled(TimeNs from, TimeNs to, const std::function<double(TimeNs)>& flow,
+                                      const std::function<bool(TimeNs)>& open) {
+    std::vector<HydraulicsSample> samples;
+    for (TimeNs t = from; t < to; t += 10 * kMs) {
+        samples.push_back({t, flow(t), static_cast<std::uint16_t>(open(t) ? 7 : 0)});
+    }
     return samples;
+}
+// Valves open from 1.2 s on (commanded at 1 s).
+std::vector<HydraulicsSample> sampled(TimeNs from, TimeNs to, const std::function<double(TimeNs)>& flow) {
+    return sampled(from, to, flow, [](TimeNs t) { return t >= 1200 * kMs; });
 }
 
 double at(const std::map<std::string, double>& metrics, const std::string& name) {
@@ -38,84 +52,181 @@ double at(const std::map<std::string, double>& metrics, const std::string& name)
     }
     return it->second;
 }
+double at(const MetricSet& metrics, const std::string& name) { return at(metrics.values, name); }
 
-const FlowEpisode kEpisode{1 * kS, 5 * kS};  // sections commanded open at 1 s, closed at 5 s
+// Sections commanded open at 1 s; the judged window ends at 5 s.
+const std::vector<SectionCommand> kOpenAtOne{{0, 0}, {1 * kS, 7}};
+const FlowWindow kWindow{500 * kMs, 5 * kS};
+
+MetricSet flow(const std::vector<HydraulicsSample>& samples, const std::vector<SectionCommand>& commands = kOpenAtOne,
+               const std::vector<FlowReading>& kf11 = {}) {
+    return rig::harness::flow_metrics(samples, commands, kf11, kWindow, FlowJudging{20.0, 3.0, 1.7}).metrics;
+}
 
 // ---------------------------------------------------------------- flow_metrics
 
-TEST(FlowMetrics, StepOntoTargetGivesExactlyItsAdjustTime) {
-    // Near Table 2's mean (1.359 s): the flow jumps from 0 onto 20 L/min at 2.36 s (open at 1 s).
-    const auto samples = sampled(0, 6 * kS, [](TimeNs t) { return t >= 2360 * kMs ? 20.0 : 0.0; });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
+TEST(FlowMetrics, StepOntoTargetGivesItsAdjustTimeFromTheNozzlesAndFromTheCommand) {
+    // Near Table 2's mean (1.359 s): the flow jumps onto 20 L/min at 2.56 s; the
+    // nozzles started at 1.2 s (open command 1 s).
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 2560 * kMs ? 20.0 : 0.0; }));
     EXPECT_EQ(at(metrics, "flow_settled"), 1.0);
-    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.36, 1e-12);
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.36, 1e-12);  // judged: sec. 3.1.2 "from nozzle start"
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_from_command_s"), 1.56, 1e-12);
     EXPECT_EQ(at(metrics, "flow_error_pct"), 0.0);
     EXPECT_EQ(at(metrics, "flow_mean_l_min"), 20.0);
+    EXPECT_TRUE(metrics.not_measured.empty());
 }
 
 TEST(FlowMetrics, EnteringTheBandCountsNotReachingTheTarget) {
     // 19.5 L/min is inside +-3 % (19.4-20.6): settled from there on; error 2.5 %.
-    const auto samples = sampled(0, 6 * kS, [](TimeNs t) { return t >= 2 * kS ? 19.5 : 10.0; });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 2200 * kMs ? 19.5 : 10.0; }));
     EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.0, 1e-12);
     EXPECT_NEAR(at(metrics, "flow_error_pct"), 2.5, 1e-9);
     EXPECT_NEAR(at(metrics, "flow_mean_l_min"), 19.5, 1e-9);
 }
 
-TEST(FlowMetrics, LeavingTheBandRestartsTheAdjustTime) {
+TEST(FlowMetrics, LeavingTheBandRestartsTheSettling) {
     // On target at 2.0 s, out (21 L/min, +5 %) from 3.00 to 3.10 s, back for good at 3.10 s.
-    const auto samples = sampled(0, 6 * kS, [](TimeNs t) {
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) {
         if (t < 2 * kS) return 0.0;
         if (t >= 3 * kS && t < 3100 * kMs) return 21.0;
         return 20.0;
-    });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
+    }));
     EXPECT_EQ(at(metrics, "flow_settled"), 1.0);
-    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 2.1, 1e-12);
-    EXPECT_EQ(at(metrics, "flow_error_pct"), 0.0);  // measured after settling only
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.9, 1e-12);
+    // The flow was due to be steady 1.7 s after the nozzles started (2.9 s): the
+    // excursion after that counts in the error (10 samples of 5 % in 210).
+    EXPECT_NEAR(at(metrics, "flow_error_pct"), 10 * 5.0 / 210.0, 1e-9);
 }
 
-TEST(FlowMetrics, NeverSettlingGivesTheEpisodeLength) {
-    // 25 L/min throughout (+25 %): never in the band. Adjust time = 4 s (the episode),
-    // error taken from open + 1.7 s: 25 %.
-    const auto samples = sampled(0, 6 * kS, [](TimeNs) { return 25.0; });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
+TEST(FlowMetrics, NeverSettlingIsNotMeasuredWithTheReasonNeverASmallNumber) {
+    // 25 L/min throughout (+25 %): never in the band.
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 1200 * kMs ? 25.0 : 0.0; }));
     EXPECT_EQ(at(metrics, "flow_settled"), 0.0);
-    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 4.0, 1e-12);
+    EXPECT_EQ(metrics.values.count("flow_adjust_time_s"), 0u);
+    EXPECT_EQ(metrics.values.count("flow_adjust_time_from_command_s"), 0u);
+    ASSERT_EQ(metrics.not_measured.count("flow_adjust_time_s"), 1u);
+    EXPECT_NE(metrics.not_measured.at("flow_adjust_time_s").find("never settled"), std::string::npos);
+    // The error still counts from when the flow was due to be steady: 25 %.
     EXPECT_NEAR(at(metrics, "flow_error_pct"), 25.0, 1e-9);
-    // Leaving the band in the episode's last sample also counts as not settled.
-    const auto late = sampled(0, 6 * kS, [](TimeNs t) { return t >= 4990 * kMs ? 30.0 : 20.0; });
-    EXPECT_EQ(at(rig::harness::flow_metrics(late, kEpisode, 20.0), "flow_settled"), 0.0);
+    // Leaving the band in the window's last sample also counts as not settled.
+    const auto late = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 4990 * kMs ? 30.0 : 20.0; }));
+    EXPECT_EQ(at(late, "flow_settled"), 0.0);
+}
+
+TEST(FlowMetrics, SectionsThatNeverOpenLeaveNothingToMeasure) {
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs) { return 0.0; }, [](TimeNs) { return false; }),
+                              {{0, 0}});
+    EXPECT_EQ(at(metrics, "flow_settled"), 0.0);
+    for (const char* name : {"flow_adjust_time_s", "flow_adjust_time_from_command_s", "flow_error_pct"}) {
+        ASSERT_EQ(metrics.not_measured.count(name), 1u) << name;
+        EXPECT_NE(metrics.not_measured.at(name).find("never opened"), std::string::npos) << name;
+    }
+}
+
+TEST(FlowMetrics, FlickeringSectionsNeverSettle) {
+    // The sections chatter: commanded shut for 50 ms every 0.5 s; each time the
+    // valves shut (0.2 s later), the boom line empties and refills over 0.8 s.
+    std::vector<SectionCommand> commands{{0, 0}, {1 * kS, 7}};
+    for (TimeNs t = 1500 * kMs; t < 5 * kS; t += 500 * kMs) {
+        commands.push_back({t, 0});
+        commands.push_back({t + 50 * kMs, 7});
+    }
+    auto shut = [](TimeNs t) {  // valves shut 50 ms, 0.2 s after each drop
+        if (t < 1700 * kMs) return t < 1200 * kMs;
+        return (t - 1700 * kMs) % (500 * kMs) < 50 * kMs;
+    };
+    auto refill = [&](TimeNs t) {
+        if (t < 1200 * kMs) return 0.0;
+        const TimeNs since_shut = t < 1700 * kMs ? t - 1200 * kMs : (t - 1700 * kMs) % (500 * kMs) - 50 * kMs;
+        return since_shut < 0 ? 0.0 : 20.0 * std::min(1.0, static_cast<double>(since_shut) / (800.0 * kMs));
+    };
+    const auto metrics =
+        flow(sampled(0, 6 * kS, [&](TimeNs t) { return shut(t) ? 0.0 : refill(t); }, [&](TimeNs t) { return !shut(t); }),
+             commands);
+    EXPECT_EQ(at(metrics, "flow_settled"), 0.0);
+    ASSERT_EQ(metrics.not_measured.count("flow_adjust_time_s"), 1u);
+    EXPECT_NE(metrics.not_measured.at("flow_adjust_time_s").find("started 8 times"), std::string::npos)
+        << metrics.not_measured.at("flow_adjust_time_s");
+    EXPECT_EQ(at(metrics, "flow_nozzle_starts_count"), 8.0);
+    EXPECT_GT(at(metrics, "flow_error_pct"), 3.0);
+}
+
+TEST(FlowMetrics, ACommandBlipTooShortForTheValvesIsNoRestart) {
+    // Open at 1 s, a 20 ms drop at 2 s that the valves (0.2 s dead time, nominal)
+    // never act on here: the flow was on target from 2.5 s and stays; the
+    // adjust time counts from the real start (1.2 s), not from the blip.
+    const std::vector<SectionCommand> commands{{0, 0}, {1 * kS, 7}, {2 * kS, 0}, {2020 * kMs, 7}};
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 2500 * kMs ? 20.0 : 0.0; }), commands);
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.3, 1e-12);
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_from_command_s"), 1.5, 1e-12);
+    EXPECT_EQ(metrics.values.count("flow_nozzle_starts_count"), 0u);
+}
+
+TEST(FlowMetrics, ARealRestartTimesTheAdjustmentFromTheLastStart) {
+    // Open 1 s, shut 2.5-2.9 s (valves 2.7-3.1 s), open again: the flow refills
+    // and settles at 4.0 s; the last start was at 3.1 s: 0.9 s.
+    const std::vector<SectionCommand> commands{{0, 0}, {1 * kS, 7}, {2500 * kMs, 0}, {2900 * kMs, 7}};
+    const auto metrics = flow(
+        sampled(0, 6 * kS, [](TimeNs t) { return t >= 4 * kS ? 20.0 : (t >= 2 * kS && t < 2700 * kMs ? 20.0 : 5.0); },
+                [](TimeNs t) { return t >= 1200 * kMs && !(t >= 2700 * kMs && t < 3100 * kMs); }),
+        commands);
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 0.9, 1e-12);
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_from_command_s"), 1.1, 1e-12);
+    EXPECT_EQ(at(metrics, "flow_nozzle_starts_count"), 2.0);
 }
 
 TEST(FlowMetrics, FlowErrorIsTheMeanRelativeDeviationAfterSettling) {
     // Settled at 2 s; then alternately 20.4 (+2 %) and 19.8 (-1 %): mean 1.5 %, mean
-    // flow 20.1. The samples from 2.00 to 4.99 s are 300, half of each.
-    // Outside the episode (before the open command, after the close) wild values must not count.
-    const auto samples = sampled(0, 7 * kS, [](TimeNs t) {
-        if (t < 1 * kS || t > 5 * kS) return 100.0;
+    // flow 20.1. Outside the window (before the opening, at and after its end) wild values must not count.
+    const auto metrics = flow(sampled(0, 7 * kS, [](TimeNs t) {
+        if (t < 1 * kS || t >= 5 * kS) return 100.0;
         if (t < 2 * kS) return 0.0;
-        if (t == 5 * kS) return 20.0;  // the episode's end instant is inside it
         return (t / (10 * kMs)) % 2 == 0 ? 20.4 : 19.8;
-    });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
-    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.0, 1e-12);
-    // 150 x 2 % + 150 x 1 % + 1 x 0 % over 301 samples.
-    EXPECT_NEAR(at(metrics, "flow_error_pct"), (150 * 2.0 + 150 * 1.0) / 301.0, 1e-9);
-    EXPECT_NEAR(at(metrics, "flow_mean_l_min"), (150 * 20.4 + 150 * 19.8 + 20.0) / 301.0, 1e-9);
+    }));
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 0.8, 1e-12);
+    EXPECT_NEAR(at(metrics, "flow_error_pct"), 1.5, 1e-9);
+    EXPECT_NEAR(at(metrics, "flow_mean_l_min"), 20.1, 1e-9);
 }
 
 TEST(FlowMetrics, FlowErrorIsRelativeToTheTarget) {
     // Table 5 at 3 km/h: 19.58 L/min against 20 is 2.1 % of the target (2.145 % of
     // the measured flow). The paper prints -2.08 %, presumably from unrounded means.
-    const auto samples = sampled(0, 6 * kS, [](TimeNs t) { return t >= 2 * kS ? 19.58 : 0.0; });
-    const auto metrics = rig::harness::flow_metrics(samples, kEpisode, 20.0);
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 2 * kS ? 19.58 : 0.0; }));
     EXPECT_NEAR(at(metrics, "flow_error_pct"), 2.1, 1e-9);
 }
 
-TEST(FlowMetrics, NoSamplesInTheEpisodeGiveNoMetrics) {
-    const auto samples = sampled(6 * kS, 7 * kS, [](TimeNs) { return 20.0; });
-    EXPECT_TRUE(rig::harness::flow_metrics(samples, kEpisode, 20.0).empty());
+TEST(FlowMetrics, Kf11ReadingsGiveThePapersSignedError) {
+    // The meter reads 19.58 L/min from 2 s on (the controller's own readings,
+    // Table 5's way): -2.1 % over the settled stretch; from the nozzles' start
+    // (1.2 s) the zeros of the filling line count too.
+    std::vector<FlowReading> kf11;
+    for (TimeNs t = 0; t < 6 * kS; t += 10 * kMs) kf11.push_back({t, t >= 2 * kS ? 19.58 : 0.0});
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 2 * kS ? 20.0 : 0.0; }), kOpenAtOne, kf11);
+    EXPECT_NEAR(at(metrics, "flow_error_kf11_settled_signed_pct"), -2.1, 1e-9);
+    EXPECT_NEAR(at(metrics, "flow_error_kf11_signed_pct"), 100.0 * (300 * 19.58 / 380.0 - 20.0) / 20.0, 1e-9);
+}
+
+TEST(Kf11Readings, Eq3OnTheRecordedCountsAndCaptureTimes) {
+    // 90 pulses/L at 20 L/min: 30 pulses/s, an edge every 33 333 us; samples every 10 ms.
+    std::vector<rig::harness::FlowMeterCountSample> samples;
+    for (TimeNs t = 0; t <= 2 * kS; t += 10 * kMs) {
+        const auto edges = static_cast<std::uint32_t>(t / 33'333'333);
+        samples.push_back({t, edges, edges * 33'333u});
+    }
+    const auto readings = rig::harness::kf11_readings(samples, 90.0, 0.25);
+    ASSERT_EQ(readings.size(), samples.size());
+    // Over the last edges' spacing: 60 w / (k t2) with t2 from the capture timer.
+    EXPECT_NEAR(readings.back().flow_l_min, 20.0, 0.01);
+    // Counter and capture timer wrap: unsigned differences carry across.
+    std::vector<rig::harness::FlowMeterCountSample> wrapped;
+    for (const auto& sample : samples) {
+        wrapped.push_back({sample.t_ns, sample.count_pulses - 20u, sample.last_edge_capture_us - 500'000u});
+    }
+    EXPECT_NEAR(rig::harness::kf11_readings(wrapped, 90.0, 0.25).back().flow_l_min, 20.0, 0.01);
+    // No new edge for more than two windows: the flow has stopped.
+    samples.push_back({3 * kS, samples.back().count_pulses, samples.back().last_edge_capture_us});
+    EXPECT_EQ(rig::harness::kf11_readings(samples, 90.0, 0.25).back().flow_l_min, 0.0);
 }
 
 // ---------------------------------------------------------------- deposition_metrics
@@ -136,9 +247,12 @@ DoseProfile profile(const std::function<double(int)>& first, const std::function
     return p;
 }
 
-DepositionJudging judging() {
+// The strip that must be sprayed: -8 to +8 m (the profile spans -10 to +10 m).
+DepositionJudging judging(double strip_from_m = -8.0, double strip_to_m = 8.0) {
     DepositionJudging j;
     j.nominal_dose_ul_cm2 = kNominal;
+    j.strip_from_m = strip_from_m;
+    j.strip_to_m = strip_to_m;
     return j;  // sprayed above half the nominal dose; CV rows 0.3 m, windows 6 m
 }
 
@@ -155,19 +269,19 @@ TEST(DepositionMetrics, OverlapOfOnePointFiveMetresIsMeasuredAsSuch) {
     const auto p = profile([](int i) { return i < 200 ? kNominal : 0.0; },
                            [](int i) { return i >= 170 ? kNominal : 0.0; });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_NEAR(at(result.metrics, "overlap_m"), 1.5, 1e-12);
-    EXPECT_EQ(at(result.metrics, "missed_m"), 0.0);
-    EXPECT_NEAR(at(result.metrics, "repeated_from_m"), -1.5, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "repeated_to_m"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "overlap_m"), 1.5, 1e-12);
+    EXPECT_EQ(at(result.metrics.values, "missed_m"), 0.0);
+    EXPECT_NEAR(at(result.metrics.values, "repeated_from_m"), -1.5, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "repeated_to_m"), 0.0, 1e-9);
     const AreaSpan* repeated = find_area(result.areas, "repeated");
     ASSERT_NE(repeated, nullptr);
     EXPECT_NEAR(repeated->from_along_m, -1.5, 1e-9);
     EXPECT_NEAR(repeated->to_along_m, 0.0, 1e-9);
     EXPECT_EQ(find_area(result.areas, "missed"), nullptr);
     // Uniform doses: every area's CV is 0.
-    EXPECT_NEAR(at(result.metrics, "cv_operational_pct"), 0.0, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "cv_repeated_pct"), 0.0, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "cv_continuation_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_operational_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_repeated_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_continuation_pct"), 0.0, 1e-9);
 }
 
 TEST(DepositionMetrics, GapOfSixtyCentimetresIsMissed) {
@@ -175,22 +289,22 @@ TEST(DepositionMetrics, GapOfSixtyCentimetresIsMissed) {
     const auto p = profile([](int i) { return i < 200 ? kNominal : 0.0; },
                            [](int i) { return i >= 212 ? kNominal : 0.0; });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_NEAR(at(result.metrics, "missed_m"), 0.6, 1e-12);
-    EXPECT_EQ(at(result.metrics, "overlap_m"), 0.0);
+    EXPECT_NEAR(at(result.metrics.values, "missed_m"), 0.6, 1e-12);
+    EXPECT_EQ(at(result.metrics.values, "overlap_m"), 0.0);
     const AreaSpan* missed = find_area(result.areas, "missed");
     ASSERT_NE(missed, nullptr);
     EXPECT_NEAR(missed->from_along_m, 0.0, 1e-9);
     EXPECT_NEAR(missed->to_along_m, 0.6, 1e-9);
     EXPECT_EQ(find_area(result.areas, "repeated"), nullptr);
-    EXPECT_EQ(result.metrics.count("cv_repeated_pct"), 0u);
+    EXPECT_EQ(result.metrics.values.count("cv_repeated_pct"), 0u);
 }
 
 TEST(DepositionMetrics, PassesMeetingExactlyGiveNeitherOverlapNorGap) {
     const auto p = profile([](int i) { return i < 200 ? kNominal : 0.0; },
                            [](int i) { return i >= 200 ? kNominal : 0.0; });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_EQ(at(result.metrics, "overlap_m"), 0.0);
-    EXPECT_EQ(at(result.metrics, "missed_m"), 0.0);
+    EXPECT_EQ(at(result.metrics.values, "overlap_m"), 0.0);
+    EXPECT_EQ(at(result.metrics.values, "missed_m"), 0.0);
     EXPECT_EQ(find_area(result.areas, "missed"), nullptr);
     EXPECT_EQ(find_area(result.areas, "repeated"), nullptr);
     // Without a repeated area the breakpoint separates the operational and continuation areas.
@@ -204,13 +318,41 @@ TEST(DepositionMetrics, PassesMeetingExactlyGiveNeitherOverlapNorGap) {
     EXPECT_EQ(continuation->to_along_m, 6.0);
 }
 
-TEST(DepositionMetrics, UnsprayedEndsOfTheTrackAreNotMissed) {
-    // Spray only between -5 and +5 m: the unsprayed rows outside are before the first
-    // and after the last sprayed row, not gaps.
+TEST(DepositionMetrics, OnlyTheStripThatMustBeSprayedIsJudged) {
+    // Spray only between -5 and +5 m: with the strip -5..+5 nothing is missed; the
+    // bare ground outside it is not the controller's business.
     const auto p = profile([](int i) { return i >= 100 && i < 200 ? kNominal : 0.0; },
                            [](int i) { return i >= 200 && i < 300 ? kNominal : 0.0; });
+    EXPECT_EQ(at(rig::harness::deposition_metrics(p, judging(-5.0, 5.0), 0.0).metrics.values, "missed_m"), 0.0);
+    // With the strip -8..+8 the unsprayed 3 m at each end are missed (row
+    // centres -7.975..-5.025 and 5.025..7.975: 60 + 60 rows of 0.05 m).
+    const auto wider = rig::harness::deposition_metrics(p, judging(), 0.0);
+    EXPECT_NEAR(at(wider.metrics.values, "missed_m"), 6.0, 1e-9);
+    EXPECT_NEAR(at(wider.metrics.values, "strip_length_m"), 16.0, 1e-12);
+}
+
+TEST(DepositionMetrics, NeverResumingMissesTheWholeSpanAfterTheBreakpoint) {
+    // The first pass sprays up to the breakpoint; the continuation never comes:
+    // everything from the breakpoint to the strip's end (8 m) is missed, however
+    // the sprayed rows lie (the old rule counted only between sprayed rows: 0).
+    const auto p = profile([](int i) { return i < 200 ? kNominal : 0.0; }, [](int) { return 0.0; });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_EQ(at(result.metrics, "missed_m"), 0.0);
+    EXPECT_NEAR(at(result.metrics.values, "missed_m"), 8.0, 1e-9);
+    EXPECT_EQ(at(result.metrics.values, "overlap_m"), 0.0);
+    const AreaSpan* missed = find_area(result.areas, "missed");
+    ASSERT_NE(missed, nullptr);
+    EXPECT_NEAR(missed->from_along_m, 0.0, 1e-9);
+    EXPECT_NEAR(missed->to_along_m, 8.0, 1e-9);
+}
+
+TEST(DepositionMetrics, NeverSprayingMissesTheWholeStrip) {
+    const auto p = profile([](int) { return 0.0; }, [](int) { return 0.0; });
+    const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
+    EXPECT_NEAR(at(result.metrics.values, "missed_m"), 16.0, 1e-9);
+    EXPECT_EQ(at(result.metrics.values, "overlap_m"), 0.0);
+    // A strip reaching past the recorded grid: rows outside it were not sprayed either.
+    EXPECT_NEAR(at(rig::harness::deposition_metrics(p, judging(-12.0, 12.0), 0.0).metrics.values, "missed_m"), 24.0,
+                0.05 + 1e-9);
 }
 
 TEST(DepositionMetrics, RowBelowHalfTheNominalDoseCountsAsUnsprayed) {
@@ -223,7 +365,7 @@ TEST(DepositionMetrics, RowBelowHalfTheNominalDoseCountsAsUnsprayed) {
         },
         [](int i) { return i >= 200 ? kNominal : 0.0; });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_NEAR(at(result.metrics, "missed_m"), 0.05, 1e-12);
+    EXPECT_NEAR(at(result.metrics.values, "missed_m"), 0.05, 1e-12);
     const AreaSpan* missed = find_area(result.areas, "missed");
     ASSERT_NE(missed, nullptr);
     EXPECT_NEAR(missed->from_along_m, -2.0, 1e-9);
@@ -239,8 +381,8 @@ TEST(DepositionMetrics, ContinuationCvByHand) {
                                return ((i - 200) / 6) % 2 == 0 ? 1.0 : 3.0;
                            });
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
-    EXPECT_NEAR(at(result.metrics, "cv_continuation_pct"), 50.0, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "cv_operational_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_continuation_pct"), 50.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_operational_pct"), 0.0, 1e-9);
 }
 
 TEST(DepositionMetrics, CvAreasStopWhereTheSprayingStops) {
@@ -256,8 +398,8 @@ TEST(DepositionMetrics, CvAreasStopWhereTheSprayingStops) {
     ASSERT_NE(continuation, nullptr);
     EXPECT_NEAR(operational->from_along_m, -3.0, 1e-9);
     EXPECT_NEAR(continuation->to_along_m, 2.0, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "cv_operational_pct"), 0.0, 1e-9);
-    EXPECT_NEAR(at(result.metrics, "cv_continuation_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_operational_pct"), 0.0, 1e-9);
+    EXPECT_NEAR(at(result.metrics.values, "cv_continuation_pct"), 0.0, 1e-9);
 }
 
 // ---------------------------------------------------------------- Eq. 10-12

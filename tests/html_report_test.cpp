@@ -112,6 +112,8 @@ CaseResult error_case() {
     result.seed = 1;
     result.limits = {{"overlap_m", 3.3}};
     result.error = "node 'plant' stopped answering at t=12.5 s <exit 9>";
+    result.error_kind = "node_unresponsive";
+    result.failures = {"error: node_unresponsive: " + result.error};  // as judge_case() gives it
     result.sim_seconds = 12.5;
     result.wall_seconds = 10.0;
     return result;
@@ -203,10 +205,10 @@ TEST_F(HtmlReportTest, DrawsFiguresEscapesNamesShowsErrorsAndIsWellFormed) {
     EXPECT_NE(page.find("gnss &lt;rs232&gt;"), std::string::npos);
 
     // The error is prominent in the case's own section and in the table.
-    EXPECT_NE(page.find("<div class=\"error-box\"><strong>The case did not run to the end:</strong>\n<pre>node 'plant' "
-                        "stopped answering at t=12.5 s &lt;exit 9&gt;</pre>"),
+    EXPECT_NE(page.find("<div class=\"error-box\"><strong>The case did not run to the end (node_unresponsive):"
+                        "</strong>\n<pre>node 'plant' stopped answering at t=12.5 s &lt;exit 9&gt;</pre>"),
               std::string::npos);
-    EXPECT_NE(page.find("<li>error: node 'plant' stopped answering"), std::string::npos);
+    EXPECT_NE(page.find("<li>error: node_unresponsive: node 'plant' stopped answering"), std::string::npos);
     // Failing limited metrics are highlighted, with enough digits.
     EXPECT_NE(page.find("<div class=\"metric-line over\"><span class=\"name\">overlap_m</span> <span "
                         "class=\"num\">3.61 / 3.3</span></div>"),

@@ -53,6 +53,8 @@ CaseResult errored_case() {
     result.file = "cases/dies.yaml";
     result.passed = false;
     result.error = "node 'plant' stopped answering <tick 12> & exited \"137\"\x01\xff";
+    result.error_kind = "node_unresponsive";
+    result.failures = {"error: node_unresponsive: " + result.error};  // as judge_case() gives it
     result.wall_seconds = 10.0;
     return result;
 }
@@ -134,6 +136,56 @@ TEST(Judge, JudgeCaseExplainsANegativeCaseThatDidNotFail) {
     EXPECT_TRUE(plain.passed);
     EXPECT_FALSE(plain.expected_failure);
     EXPECT_TRUE(plain.failures.empty());
+}
+
+TEST(Judge, NotMeasuredBecauseOfTheControllerIsABreakACaseMayExpect) {
+    const std::map<std::string, double> limits = {{"flow_adjust_time_s", 1.7}, {"overlap_m", 3.3}};
+    const std::map<std::string, std::string> why = {{"flow_adjust_time_s", "never settled: the flow left the band"}};
+    const auto failures = judge({{"overlap_m", 1.0}}, why, limits);
+    ASSERT_EQ(failures.size(), 1u);
+    EXPECT_EQ(failures[0], "flow_adjust_time_s not measured: never settled: the flow left the band");
+    // Expected: exactly that break passes as such; a merely missing metric never does.
+    EXPECT_TRUE(passes_with_expectation(failures, {"flow_adjust_time_s"}));
+    EXPECT_FALSE(passes_with_expectation(judge({{"overlap_m", 1.0}}, limits), {"flow_adjust_time_s"}));
+}
+
+TEST(Judge, AnErroredCasePassesOnlyWhenItIsTheErrorItExpects) {
+    VerdictInputs crashed;
+    crashed.limits = {{"missed_m", 0.0}};
+    crashed.metrics = {{"missed_m", 12.0}};  // from the partial trace: reported, not judged
+    crashed.error_kind = "node_exited";
+    crashed.error = "node 'controller': process killed by signal 6";
+    CaseVerdict verdict = judge_case(crashed);
+    EXPECT_FALSE(verdict.passed);
+    EXPECT_FALSE(verdict.expected_failure);
+    EXPECT_EQ(verdict.failures, (std::vector<std::string>{"error: node_exited: node 'controller': process killed by signal 6"}));
+
+    crashed.expect_error = "node_exited";
+    verdict = judge_case(crashed);
+    EXPECT_TRUE(verdict.passed);
+    EXPECT_TRUE(verdict.expected_failure);
+
+    crashed.expect_error = "node_unresponsive";
+    verdict = judge_case(crashed);
+    EXPECT_FALSE(verdict.passed);
+    EXPECT_EQ(verdict.failures.back(), "expected the run to end in node_unresponsive, got node_exited");
+
+    VerdictInputs ran_through;
+    ran_through.limits = {{"missed_m", 0.0}};
+    ran_through.metrics = {{"missed_m", 0.0}};
+    ran_through.expect_error = "node_exited";
+    verdict = judge_case(ran_through);
+    EXPECT_FALSE(verdict.passed);
+    EXPECT_EQ(verdict.failures.back(), "expected the run to end in node_exited, but it ran to its end");
+
+    // The result of an expected error counts as passed; any other error fails.
+    CaseResult result = passing_case();
+    result.error = "node 'controller': gone";
+    result.error_kind = "node_exited";
+    result.expected_error = "node_exited";
+    EXPECT_TRUE(case_passed(result));
+    result.expected_error = "";
+    EXPECT_FALSE(case_passed(result));
 }
 
 TEST(Summary, CountsCasesWithErrorsAsFailed) {
@@ -279,7 +331,7 @@ TEST(JunitXml, IsWellFormedAndEscaped) {
               std::string::npos)
         << xml;
     // Error text: escaped, control character and invalid UTF-8 replaced by U+FFFD.
-    EXPECT_NE(xml.find("<error type=\"error\" message=\"node &apos;plant&apos; stopped answering &lt;tick 12&gt; &amp; exited "
+    EXPECT_NE(xml.find("<error type=\"node_unresponsive\" message=\"node &apos;plant&apos; stopped answering &lt;tick 12&gt; &amp; exited "
                        "&quot;137&quot;\xEF\xBF\xBD\xEF\xBF\xBD\">"),
               std::string::npos)
         << xml;
@@ -309,7 +361,7 @@ TEST(ResultTable, ShowsVerdictsMetricsAndFailures) {
     EXPECT_NE(table.find("breakpoint_error_m 0.0929 / 0.16"), std::string::npos) << table;
     EXPECT_NE(table.find("overlap_m 3.61 > 3.3"), std::string::npos) << table;
     EXPECT_NE(table.find("breakpoint_error_m 0.79 > 0.16 (expected)"), std::string::npos) << table;
-    EXPECT_NE(table.find("error: node 'plant' stopped answering"), std::string::npos) << table;
+    EXPECT_NE(table.find("error: node_unresponsive: node 'plant' stopped answering"), std::string::npos) << table;
     // Last line alone: the count CI log readers look for.
     EXPECT_TRUE(table.ends_with("\n2 passed, 2 failed\n")) << table;
 

@@ -3,6 +3,7 @@
 // (whole runs, the network check, the negative cases).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -24,6 +25,17 @@ inline std::string read_all(const std::filesystem::path& path) {
     std::stringstream text;
     text << in.rdbuf();
     return text.str();
+}
+
+// What a shell command prints on its standard output ("" if it cannot run).
+inline std::string read_all_command(const std::string& command) {
+    std::string output;
+    if (FILE* pipe = ::popen(command.c_str(), "r")) {
+        char buffer[4096];
+        while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+        ::pclose(pipe);
+    }
+    return output;
 }
 
 }  // namespace rig::testing

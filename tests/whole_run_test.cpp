@@ -9,6 +9,8 @@
 #include "run_support.h"
 
 #include <chrono>
+#include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +30,8 @@ namespace fs = std::filesystem;
 fs::path fresh_dir(const std::string& name) { return rig::testing::fresh_dir("whole-run-" + name); }
 
 using rig::testing::read_all;
+
+using rig::testing::read_all_command;
 
 struct RunOutcome {
     int exit_code = -1;
@@ -62,6 +66,42 @@ TEST(WholeRun, SameSeedGivesTheSameTraceAndAnotherSeedDoesNot) {
     EXPECT_EQ(digest.size(), 64u);
     EXPECT_EQ(second.results["cases"][0]["trace_sha256"], digest);
     EXPECT_NE(other.results["cases"][0]["trace_sha256"], digest);
+}
+
+// `rig judge` recomputes a run's results from its traces alone, exactly: every
+// metric bit for bit, every verdict, every digest (the demo checks its whole
+// suite the same way). One case of each scenario.
+TEST(WholeRun, RejudgingTheTracesGivesExactlyTheRunsResults) {
+    const fs::path dir = fresh_dir("rejudge");
+    const RunOutcome run = rig_run("'" RIG_SOURCE_DIR "/cases/table1-spray-timing' '" RIG_SOURCE_DIR
+                                   "/cases/table2-flow-adjust/table2-20lmin-opening93.yaml' " + kShortCase +
+                                       " --jobs 2",
+                                   dir / "run");
+    ASSERT_EQ(run.exit_code, 0) << run.log;
+    ASSERT_EQ(run.results["cases"].size(), 3u);
+    const std::string command = "'" RIG_BINARY_DIR "/bin/rig' judge '" + (dir / "run").string() + "' --check --out '" +
+                                (dir / "again").string() + "' > '" + (dir / "judge.log").string() + "' 2>&1";
+    const int status = std::system(command.c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << read_all(dir / "judge.log");
+    EXPECT_NE(read_all(dir / "judge.log").find("re-judged: every metric, verdict and digest as recorded"),
+              std::string::npos)
+        << read_all(dir / "judge.log");
+    const nlohmann::json again = nlohmann::json::parse(read_all(dir / "again" / "results.json"));
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(again["cases"][i]["metrics"], run.results["cases"][i]["metrics"]) << i;
+        EXPECT_EQ(again["cases"][i]["trace_sha256"], run.results["cases"][i]["trace_sha256"]) << i;
+    }
+    EXPECT_TRUE(fs::exists(dir / "again" / "report.html"));
+    // A metric that differs is found: change one recorded value in results.json.
+    nlohmann::json changed = run.results;
+    changed["cases"][1]["metrics"]["flow_adjust_time_s"] = 0.5;
+    std::ofstream(dir / "run" / "results.json") << changed.dump(2);
+    const int differs = std::system(("'" RIG_BINARY_DIR "/bin/rig' judge '" + (dir / "run").string() +
+                                     "' --check > '" + (dir / "judge2.log").string() + "' 2>&1")
+                                        .c_str());
+    EXPECT_EQ(WIFEXITED(differs) ? WEXITSTATUS(differs) : -1, 1) << read_all(dir / "judge2.log");
+    EXPECT_NE(read_all(dir / "judge2.log").find("metric flow_adjust_time_s was 0.5"), std::string::npos)
+        << read_all(dir / "judge2.log");
 }
 
 TEST(WholeRun, ControllerThatStopsAnsweringFailsByNameInBoundedTime) {
@@ -134,6 +174,75 @@ TEST(WholeRun, WiredControllerInRealTimePassesThePapersLimits) {
     for (const char* metric : {"flow_adjust_time_s", "flow_error_pct", "overlap_m", "missed_m", "breakpoint_error_m"}) {
         EXPECT_TRUE(result["metrics"].contains(metric)) << metric;
     }
+}
+
+// A GNSS line on a pseudo-terminal that no board has opened: the rig must not
+// stream into it for the whole case (it used to end after the case's wall-time
+// bound with "simulated 0.0 s" and an empty trace), but fail at once, naming
+// the port, and keep what it recorded.
+TEST(WholeRun, AGnssLineNobodyReadsFailsAtOnceNamingThePort) {
+    const fs::path dir = fresh_dir("unread-gnss");
+    std::string text = read_all(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    text += "mode: realtime\nwiring: { gnss: serial, gnss_port: pty, controller: external }\n";
+    std::ofstream(dir / "unread.yaml") << text;
+    const auto started = std::chrono::steady_clock::now();
+    const RunOutcome outcome = rig_run("'" + (dir / "unread.yaml").string() + "'", dir / "out");
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    EXPECT_EQ(outcome.exit_code, 1) << outcome.log;
+    ASSERT_TRUE(outcome.results.contains("cases")) << outcome.log;
+    const nlohmann::json& result = outcome.results["cases"][0];
+    EXPECT_EQ(result["error_kind"], "wire_unread") << result.dump(2);
+    const std::string error = result["error"].is_string() ? result["error"].get<std::string>() : "";
+    EXPECT_NE(error.find("nobody reads the GNSS line /dev/pts/"), std::string::npos) << error;
+    // The case is longer than this bound (about 12 s of route); the 2 s unread
+    // bound plus start-up is far below it, even on a loaded machine.
+    EXPECT_LT(wall_s, 11.0);
+    EXPECT_GT(result["sim_seconds"].get<double>(), 1.0) << "it ran until the line was found unread";
+    const std::string trace = result["trace_path"];
+    EXPECT_TRUE(fs::exists(trace)) << trace;
+}
+
+// SIGINT (Ctrl-C) or SIGTERM during `rig run`: the running case ends as
+// interrupted with its trace kept, the cases not yet started are reported as not
+// run, results.json is written, and the exit status is 128 + the signal.
+TEST(WholeRun, AnInterruptedRunKeepsItsResultsAndTraces) {
+    const fs::path dir = fresh_dir("interrupt");
+    const fs::path out = dir / "out";
+    const fs::path continuation = RIG_SOURCE_DIR "/cases/table5-6-continuation/continuation-6kmh.yaml";
+    rig::ChildProcess run({RIG_BINARY_DIR "/bin/rig", "run", continuation.string(),
+                           RIG_SOURCE_DIR "/cases/table5-6-continuation/continuation-3kmh.yaml", "--out", out.string(),
+                           "--jobs", "1"},
+                          dir / "rig.log");
+    // Wait until the first case has committed rows to its trace (its first batch).
+    const fs::path trace = out / "cases" / "continuation-6kmh" / "trace.sqlite";
+    bool recording = false;
+    for (int i = 0; i < 6000 && !recording; ++i) {
+        if (run.exit_description()) break;
+        if (fs::exists(trace)) {
+            const std::string count = read_all_command("sqlite3 '" + trace.string() + "' 'select count(*) from samples' 2>/dev/null");
+            recording = !count.empty() && std::atoll(count.c_str()) > 0;
+        }
+        if (!recording) rig::RealtimeClock().sleep_until_ns(rig::RealtimeClock().now_ns() + rig::seconds_to_ns(0.01));
+    }
+    ASSERT_TRUE(recording) << read_all(dir / "rig.log");
+    ::kill(run.pid(), SIGINT);
+    EXPECT_EQ(run.stop(std::chrono::milliseconds(30000)), "process exited with status 130") << read_all(dir / "rig.log");
+    const nlohmann::json results = nlohmann::json::parse(read_all(out / "results.json"));
+    ASSERT_EQ(results["cases"].size(), 2u) << results.dump(2);
+    const nlohmann::json& first = results["cases"][0];
+    const nlohmann::json& second = results["cases"][1];
+    // The first was running (unless it had just finished), the second never started.
+    if (!first["error_kind"].is_null()) {
+        EXPECT_EQ(first["error_kind"], "interrupted") << first.dump(2);
+        EXPECT_NE(first["error"].get<std::string>().find("SIGINT"), std::string::npos) << first.dump(2);
+    }
+    EXPECT_EQ(second["error_kind"], "interrupted") << second.dump(2);
+    EXPECT_NE(second["error"].get<std::string>().find("not run"), std::string::npos) << second.dump(2);
+    // The interrupted case's trace is whole and readable, with what it recorded.
+    const std::string samples = read_all_command("sqlite3 '" + trace.string() + "' \"select count(*) from samples; select value from meta where key = 'outcome'\"");
+    EXPECT_GT(std::atoll(samples.c_str()), 0) << samples;
+    EXPECT_TRUE(samples.find("interrupted") != std::string::npos || samples.find("completed") != std::string::npos) << samples;
+    EXPECT_TRUE(fs::exists(out / "junit.xml"));
 }
 
 // `rig emulate gnss`: a case's receiver onto a pseudo-terminal, read back by a

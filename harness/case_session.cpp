@@ -1,0 +1,174 @@
+#include "harness/case_session.h"
+
+#include <fstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "rig/hid_board.h"
+#include "rig/modbus_protocol.h"
+
+namespace rig::harness {
+
+namespace {
+
+
+// The controller's parameters as their own YAML file (the case section minus `command`).
+void write_controller_config(const CaseSpec& spec, const std::filesystem::path& file) {
+    YAML::Node section = spec.controller.params.present ? YAML::Clone(spec.controller.params.node) : YAML::Node();
+    if (section.IsMap()) section.remove("command");
+    YAML::Emitter out;
+    out << section;
+    std::ofstream(file) << "# the `controller:` section of " << spec.source_path.string() << "\n"
+                        << (section.IsNull() ? "{}" : out.c_str()) << "\n";
+}
+
+std::string log_tail(const std::filesystem::path& log, std::size_t max_lines) {
+    std::ifstream in(log);
+    std::vector<std::string> lines;
+    std::string line;
+    while (std::getline(in, line)) {
+        lines.push_back(line);
+        if (lines.size() > max_lines) lines.erase(lines.begin());
+    }
+    std::string tail;
+    for (const auto& kept : lines) tail += "\n    | " + kept;
+    return tail;
+}
+
+}  // namespace
+
+BenchWires open_bench_wires(const CaseSpec& spec) {
+    BenchWires wires;
+    const WiringSpec& wiring = spec.wiring;
+    std::vector<std::string> parts;
+    if (wiring.gnss == GnssWire::serial) {
+        SerialSettings line;
+        line.baud = wiring.nmea_baud;
+        std::string far_end;
+        if (wiring.gnss_port == "pty") {
+            wires.gnss_pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
+            wires.gnss_port = &wires.gnss_pty->master();
+            far_end = wires.gnss_pty->slave_path();
+        } else {
+            wires.gnss_device = std::make_unique<SerialPort>(wiring.gnss_port, line);
+            wires.gnss_port = wires.gnss_device.get();
+            far_end = wiring.gnss_port;
+        }
+        wires.gnss_far_end = far_end;
+        wires.controller_args.insert(wires.controller_args.end(),
+                                     {"--nmea-serial", far_end, "--nmea-baud", std::to_string(wiring.nmea_baud)});
+        parts.push_back("gnss serial " + far_end + " " + std::to_string(wiring.nmea_baud) + " baud");
+    } else {
+        parts.push_back("gnss dds");
+    }
+    switch (wiring.board_io) {
+        case BoardIoWireKind::dds: parts.push_back("board_io dds"); break;
+        case BoardIoWireKind::modbus_rtu: {
+            modbus::RtuSlaveOptions options;
+            options.line.baud = wiring.modbus_baud;
+            std::string far_end = wiring.modbus_port;
+            if (wiring.modbus_port == "pty") {
+                wires.modbus_link = std::make_unique<PtyLink>();
+                options.line.device = wires.modbus_link->slave_path_a();
+                far_end = wires.modbus_link->slave_path_b();
+            } else {
+                options.line.device = wiring.modbus_port;
+            }
+            wires.board_io = std::make_unique<ModbusSlaveWire>(options);
+            wires.controller_args.insert(wires.controller_args.end(), {"--modbus-rtu", far_end, "--modbus-baud",
+                                                                       std::to_string(wiring.modbus_baud)});
+            parts.push_back("board_io modbus_rtu " + far_end + " " + std::to_string(wiring.modbus_baud) + " baud");
+            break;
+        }
+        case BoardIoWireKind::modbus_tcp: {
+            modbus::TcpSlaveOptions options;
+            const modbus::TcpEndpoint endpoint = modbus::parse_tcp_endpoint(wiring.modbus_tcp);
+            options.bind_address = endpoint.address;
+            options.port = endpoint.port;
+            auto wire = std::make_unique<ModbusSlaveWire>(options);
+            const std::string address = endpoint.address + ":" + std::to_string(wire->slave().tcp_port());
+            wires.controller_args.insert(wires.controller_args.end(), {"--modbus-tcp", address});
+            parts.push_back("board_io modbus_tcp " + address);
+            wires.board_io = std::move(wire);
+            break;
+        }
+        case BoardIoWireKind::hid: {
+            // A real bench board; the controller is wired to it, not to the rig process.
+            auto transport = HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
+            const std::string description = transport->description();
+            wires.board_io = std::make_unique<HidBoardWire>(std::make_unique<HidBoard>(std::move(transport)), description);
+            parts.push_back("board_io hid " + description);
+            break;
+        }
+    }
+    wires.description.clear();
+    for (const std::string& part : parts) wires.description += (wires.description.empty() ? "" : ", ") + part;
+    return wires;
+}
+
+
+
+CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir)
+    : wires_(open_bench_wires(spec)), lease_(DomainLease::acquire()), controller_log_(case_dir / "controller.log") {}
+
+void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
+                                   const std::filesystem::path& case_dir) {
+    // The controller under test, in its own process on this run's own domain
+    // (none when a real board is wired up: `wiring: { controller: external }`).
+    if (spec.wiring.external_controller || controller_) return;
+    write_controller_config(spec, case_dir / "controller.yaml");
+    std::vector<std::string> argv = spec.controller.command;
+    if (argv.empty()) argv.push_back(controller_executable.string());
+    for (const std::string& arg :
+         {std::string("--domain"), std::to_string(lease_.domain_id()), std::string("--node-name"),
+          std::string("controller"), std::string("--config"), (case_dir / "controller.yaml").string(),
+          std::string("--state-dir"), (case_dir / "controller-state").string()}) {
+        argv.push_back(arg);
+    }
+    if (spec.mode == RunMode::realtime) {
+        argv.insert(argv.end(), {"--clock", "realtime"});
+        argv.insert(argv.end(), wires_.controller_args.begin(), wires_.controller_args.end());
+    }
+    controller_.emplace(argv, controller_log_);
+}
+
+CaseSession::~CaseSession() {
+    if (controller_) controller_->stop(std::chrono::milliseconds(500));
+}
+
+std::string CaseSession::controller_command_line() const {
+    return controller_ ? controller_->command_line() : "external (a wired board)";
+}
+
+std::optional<std::string> CaseSession::controller_gone() {
+    return controller_ ? controller_->exit_description() : std::nullopt;
+}
+
+std::string CaseSession::stop_controller(std::chrono::milliseconds grace) {
+    return controller_ ? controller_->stop(grace) : std::string("process exited with status 0");
+}
+
+std::string CaseSession::controller_log_tail(std::size_t max_lines) const {
+    return controller_ ? log_tail(controller_log_, max_lines) : std::string();
+}
+
+std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {
+    if (!wires_.gnss_pty) return {};
+    const std::size_t unread = wires_.gnss_pty->unread_bytes();
+    // Bytes waiting is normal between reads; bytes waiting that never go down
+    // mean nobody has the line open, or nobody reads it.
+    if (unread == 0 || unread < gnss_unread_) {
+        gnss_unread_since_.reset();
+    } else if (!gnss_unread_since_) {
+        gnss_unread_since_.emplace();
+    }
+    gnss_unread_ = unread;
+    if (gnss_unread_since_ && gnss_unread_since_->elapsed() > unread_for) {
+        return "nobody reads the GNSS line " + wires_.gnss_far_end + ": " + std::to_string(unread) +
+               " bytes of NMEA written to it have waited unread for more than " +
+               std::to_string(unread_for.count()) + " ms (is the board attached to that port?)";
+    }
+    return {};
+}
+
+}  // namespace rig::harness

@@ -1,0 +1,77 @@
+#pragma once
+// The processes and wires of one case run: its own DDS domain, the bench wires
+// it asks for (ptys, serial ports, Modbus, the HID board) and the controller
+// process started with the far ends of those wires. The session owns them and
+// ends them in order (the controller, then the wires), whatever way the run ends.
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "harness/case_spec.h"
+#include "rig/child_process.h"
+#include "rig/clock.h"
+#include "rig/domain_lease.h"
+#include "rig/pty_pair.h"
+#include "rig/serial_port.h"
+#include "rig/wire_adapters.h"
+
+namespace rig::harness {
+
+// The rig's ends of the bench wires a case asks for, and what the controller
+// process must be told to use the far ends.
+struct BenchWires {
+    std::unique_ptr<PtyPair> gnss_pty;
+    std::unique_ptr<SerialPort> gnss_device;
+    SerialPort* gnss_port = nullptr;  // the rig writes NMEA here
+    std::string gnss_far_end;         // what the controller opens
+    std::unique_ptr<PtyLink> modbus_link;
+    std::unique_ptr<BoardIoWire> board_io;
+    std::vector<std::string> controller_args;
+    std::string description = "dds";
+};
+// Opens what spec.wiring asks for; throws std::runtime_error naming the port.
+BenchWires open_bench_wires(const CaseSpec& spec);
+
+class CaseSession {
+public:
+    // Opens the wires and takes a DDS domain. Throws std::runtime_error naming
+    // what could not be opened.
+    CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir);
+    // Writes the controller's configuration into case_dir and starts the
+    // controller with the wires' far ends (unless the case wires an external
+    // board). Called once the harness's participant exists on the domain, so
+    // discovery sees the controller's from its first moment.
+    void start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
+                          const std::filesystem::path& case_dir);
+    ~CaseSession();
+    CaseSession(const CaseSession&) = delete;
+    CaseSession& operator=(const CaseSession&) = delete;
+
+    std::uint32_t domain_id() const { return lease_.domain_id(); }
+    BenchWires& wires() { return wires_; }
+    bool has_controller_process() const { return controller_.has_value(); }
+    std::string controller_command_line() const;
+    // How the controller process ended, if it has (the lockstep master's liveness check).
+    std::optional<std::string> controller_gone();
+    // Waits up to `grace` for it to end by itself, then stops it; how it ended.
+    std::string stop_controller(std::chrono::milliseconds grace);
+    // The last lines of the controller's log, for error messages.
+    std::string controller_log_tail(std::size_t max_lines = 6) const;
+    // A bench wire whose far end does not take what the rig writes: the GNSS pty
+    // holding bytes nobody read for longer than `unread_for`. Empty when fine.
+    std::string wire_problem(std::chrono::milliseconds unread_for);
+
+private:
+    BenchWires wires_;
+    DomainLease lease_;
+    std::filesystem::path controller_log_;
+    std::optional<ChildProcess> controller_;
+    // GNSS pty watch: the unread byte count, and since when it has not gone down.
+    std::size_t gnss_unread_ = 0;
+    std::optional<WallStopwatch> gnss_unread_since_;
+};
+
+}  // namespace rig::harness

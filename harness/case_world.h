@@ -1,0 +1,43 @@
+#pragma once
+// The world a case file describes, built before anything runs: the plant (route,
+// boom, land wheel), the spray circuit's parameters, the operator's script, the
+// receiver's parameters, and what the judge will hold the controller to. A pure
+// function of the case file and the seed; `rig run` and the bench tools
+// (`rig emulate gnss`) build it the same way.
+#include <cstdint>
+#include <vector>
+
+#include "emulators/gnss_g970.h"
+#include "emulators/panel_switch.h"
+#include "emulators/plant.h"
+#include "emulators/spray_circuit.h"
+#include "harness/case_spec.h"
+#include "harness/judge.h"
+
+namespace rig::harness {
+
+// What the case's vehicle does and its operator presses.
+struct ScenarioPlan {
+    std::vector<emulators::RoutePhase> route;
+    double start_along_m = 0.0;  // nozzle line at t = 0
+    std::vector<emulators::SwitchClosure> button;
+    std::vector<emulators::SwitchClosure> spray_switch;
+    double approach_starts_s = 0.0;
+};
+
+struct CaseWorld {
+    emulators::Plant plant;
+    ScenarioPlan scenario;
+    emulators::G970Params gnss;
+    emulators::SprayCircuitParams circuit;  // its deposition grid spans all the boom can reach
+    double breakpoint_crossing_s = 0.0;     // on the approach; NaN in a static test
+    TimeNs end_ns = 0;
+};
+CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed);
+
+// What the judge holds the controller to (harness/judge.h), from the case file
+// and its route only: the limits and expectations, the flow window, the strip
+// that must be sprayed, the nominal dose.
+JudgingPlan plan_judging(const CaseSpec& spec, const CaseWorld& world);
+
+}  // namespace rig::harness

@@ -1,0 +1,174 @@
+#include "harness/judge_command.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/judge.h"
+#include "harness/results_writer.h"
+
+namespace rig::harness {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Input {
+    fs::path trace;
+    fs::path out_dir;  // the run directory it came from (for --check); empty for a lone trace
+};
+
+nlohmann::json read_json(const fs::path& file) {
+    std::ifstream in(file);
+    if (!in) throw std::runtime_error("cannot read " + file.string());
+    try {
+        return nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& error) {
+        throw std::runtime_error(file.string() + ": " + error.what());
+    }
+}
+
+// The traces of a run directory, in its results.json's order when it has one.
+std::vector<Input> traces_of_run(const fs::path& dir) {
+    std::vector<Input> inputs;
+    std::set<fs::path> listed;
+    if (fs::exists(dir / "results.json")) {
+        const nlohmann::json results = read_json(dir / "results.json");
+        for (const nlohmann::json& one : results.at("cases")) {
+            const fs::path trace = dir / "cases" / one.at("name").get<std::string>() / "trace.sqlite";
+            if (fs::exists(trace) && listed.insert(trace).second) inputs.push_back({trace, dir});
+        }
+    }
+    std::vector<fs::path> found;
+    if (fs::is_directory(dir / "cases")) {
+        for (const auto& entry : fs::directory_iterator(dir / "cases")) {
+            const fs::path trace = entry.path() / "trace.sqlite";
+            if (entry.is_directory() && fs::exists(trace) && !listed.count(trace)) found.push_back(trace);
+        }
+    }
+    std::sort(found.begin(), found.end());
+    for (const fs::path& trace : found) inputs.push_back({trace, dir});
+    if (inputs.empty()) throw std::runtime_error(dir.string() + ": no cases/*/trace.sqlite in it");
+    return inputs;
+}
+
+// Differences between a judged case and what results.json said of it.
+std::vector<std::string> differences(const CaseResult& now, const nlohmann::json& before) {
+    std::vector<std::string> found;
+    auto differ = [&](const std::string& what, const std::string& was, const std::string& is) {
+        found.push_back(now.name + ": " + what + " was " + was + ", now " + is);
+    };
+    const nlohmann::json& metrics = before.at("metrics");
+    for (const auto& [name, value] : metrics.items()) {
+        const auto it = now.metrics.find(name);
+        if (it == now.metrics.end()) {
+            differ("metric " + name, value.dump(), "absent");
+        } else if (value.is_null() ? !std::isnan(it->second) : value.get<double>() != it->second) {
+            differ("metric " + name, value.dump(), nlohmann::json(it->second).dump());
+        }
+    }
+    for (const auto& [name, value] : now.metrics) {
+        if (!metrics.contains(name)) differ("metric " + name, "absent", nlohmann::json(value).dump());
+    }
+    const nlohmann::json not_measured = before.value("not_measured", nlohmann::json::object());
+    if (not_measured != nlohmann::json(now.not_measured)) {
+        differ("not_measured", not_measured.dump(), nlohmann::json(now.not_measured).dump());
+    }
+    if (before.at("passed").get<bool>() != case_passed(now)) {
+        differ("verdict", before.at("passed").dump(), case_passed(now) ? "true" : "false");
+    }
+    if (before.at("failures") != nlohmann::json(now.failures)) {
+        differ("failures", before.at("failures").dump(), nlohmann::json(now.failures).dump());
+    }
+    if (before.at("trace_sha256").get<std::string>() != now.trace_sha256) {
+        differ("trace_sha256", before.at("trace_sha256").get<std::string>(), now.trace_sha256);
+    }
+    return found;
+}
+
+}  // namespace
+
+int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err) {
+    std::vector<Input> inputs;
+    try {
+        for (const std::string& argument : options.inputs) {
+            const fs::path path(argument);
+            if (fs::is_directory(path)) {
+                for (Input& input : traces_of_run(path)) inputs.push_back(std::move(input));
+            } else if (fs::exists(path)) {
+                inputs.push_back({path, {}});
+            } else {
+                throw std::runtime_error(argument + ": no such file or directory");
+            }
+        }
+    } catch (const std::exception& error) {
+        err << "rig judge: " << error.what() << "\n";
+        return 2;
+    }
+    std::vector<CaseResult> results;
+    std::vector<CaseFigures> figures;
+    for (const Input& input : inputs) {
+        try {
+            CaseRun run = judge_trace(read_trace(input.trace));
+            results.push_back(std::move(run.result));
+            figures.push_back(std::move(run.figures));
+        } catch (const std::exception& error) {
+            err << "rig judge: " << error.what() << "\n";
+            return 2;
+        }
+    }
+    RunSummary summary = summarize(results);
+
+    std::vector<std::string> differing;
+    if (options.check) {
+        std::map<fs::path, nlohmann::json> before_by_dir;
+        for (std::size_t i = 0; i < inputs.size(); ++i) {
+            if (inputs[i].out_dir.empty()) {
+                err << "rig judge: --check needs run directories, not trace files (" << inputs[i].trace.string() << ")\n";
+                return 2;
+            }
+            if (!before_by_dir.count(inputs[i].out_dir)) {
+                try {
+                    before_by_dir[inputs[i].out_dir] = read_json(inputs[i].out_dir / "results.json");
+                } catch (const std::exception& error) {
+                    err << "rig judge: --check: " << error.what() << "\n";
+                    return 2;
+                }
+            }
+            const nlohmann::json* before = nullptr;
+            for (const nlohmann::json& one : before_by_dir[inputs[i].out_dir].at("cases")) {
+                if (one.at("name") == results[i].name) before = &one;
+            }
+            if (before == nullptr) {
+                differing.push_back(results[i].name + ": not in " + (inputs[i].out_dir / "results.json").string());
+                continue;
+            }
+            for (std::string& difference : differences(results[i], *before)) differing.push_back(std::move(difference));
+        }
+    }
+    if (!options.out_dir.empty()) {
+        try {
+            for (const std::string& problem : write_results(options.out_dir, results, summary, figures, HtmlReportOptions{})) {
+                err << "rig judge: report: " << problem << "\n";
+            }
+        } catch (const std::exception& error) {
+            err << "rig judge: cannot write the results in " << options.out_dir.string() << ": " << error.what() << "\n";
+            return 2;
+        }
+    }
+    out << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    if (options.check) {
+        for (const std::string& difference : differing) out << "differs: " << difference << "\n";
+        out << (differing.empty() ? "re-judged: every metric, verdict and digest as recorded\n"
+                                  : "re-judged: " + std::to_string(differing.size()) + " difference(s)\n");
+    }
+    if (!options.out_dir.empty()) out << "results: " << (options.out_dir / "results.json").string() << "\n";
+    return summary.failed == 0 && differing.empty() ? 0 : 1;
+}
+
+}  // namespace rig::harness

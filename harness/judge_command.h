@@ -1,0 +1,29 @@
+#pragma once
+// `rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]`: judges recorded traces
+// again (harness/judge.h), with today's metric code, and writes the same
+// results contract as `rig run` (results.json, junit.xml, report.txt, report.html).
+//   OUT_DIR   a `rig run --out` directory: every cases/*/trace.sqlite in it, in
+//             the order of its results.json (or by name when there is none)
+//   TRACE     one trace file
+//   --out     where the new results go (nothing is written without it)
+//   --check   compare with OUT_DIR/results.json: every metric bit for bit, what
+//             was not measured, the verdicts, the failures and the digests; any
+//             difference is printed and makes the exit status 1
+// Exit status: 0 when every case passed (and, with --check, nothing differs),
+// 1 otherwise, 2 for bad arguments or a trace that cannot be read.
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace rig::harness {
+
+struct JudgeCommandOptions {
+    std::vector<std::string> inputs;
+    std::filesystem::path out_dir;  // empty: print only
+    bool check = false;
+};
+
+int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace rig::harness

@@ -1,0 +1,90 @@
+#pragma once
+// A trace file (SQLite; docs/trace-format.md): the rows of a run and the judge's
+// only input. TraceFile writes one; TraceRecorder (harness/trace_recorder.h)
+// feeds it from DDS during a run, and tests write hand-made traces with it to
+// judge them (harness/judge.h) without any DDS.
+//   samples(t_ns, round, topic, json)   every sample, in delivery order
+//   deposition, landing_edges           the spray on the ground (plant truth)
+//   discovery                           endpoints other participants created
+//   foreign_samples                     truth/device samples others wrote (forged)
+//   meta                                the case, the judging plan, the outcome
+// The SHA-256 of the canonical rows ("t_ns round topic json\n" per sample in
+// order, then "deposition pass row nozzle dose\n" per cell and "landing t_ns
+// 0|1\n" per edge) is the trace's digest; `rig judge` recomputes it from the
+// tables. Discovery, forged samples and meta are not part of it (discovery's
+// timing is the machine's, not the simulation's; a forged sample fails the run).
+//
+// Rows are committed in batches as they come (write-ahead log), so a rig killed
+// mid-run leaves a readable file up to the last batch; finish() writes the
+// outcome and the digest into meta and folds the log back into the one file.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "emulators/deposition_grid.h"
+#include "emulators/spray_circuit.h"
+#include "rig/clock.h"
+#include "rig/dds_context.h"
+
+struct sqlite3;
+struct sqlite3_stmt;
+struct evp_md_ctx_st;
+
+namespace rig::harness {
+
+// Version of the trace layout (meta key `trace_format`); `rig judge` refuses
+// traces it does not know how to read.
+inline constexpr int kTraceFormat = 2;
+
+// How a case's run ended, for meta (keys `outcome`, `error_kind`, `error`, `end_ns`).
+struct TraceOutcome {
+    std::string status = "completed";  // completed | error | interrupted
+    std::string error_kind;            // rig::FailureKind name when not completed
+    std::string error;                 // what happened, naming the node
+    TimeNs end_ns = 0;                 // the last simulated instant the run reached
+};
+
+class TraceFile {
+public:
+    // Creates the file (replacing one that is there). Throws std::runtime_error naming it.
+    explicit TraceFile(const std::filesystem::path& file);
+    // A file never finished is committed as "interrupted": what was written stays readable.
+    ~TraceFile();
+    TraceFile(const TraceFile&) = delete;
+    TraceFile& operator=(const TraceFile&) = delete;
+
+    const std::filesystem::path& path() const { return file_; }
+    void set_meta(const std::string& key, const std::string& value);
+    void append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json);
+    void append_foreign(TimeNs t, int round, const std::string& topic, const std::string& participant,
+                        const std::string& guid_prefix, const nlohmann::json& json);
+    void record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoint>& endpoints);
+    void record_deposition(const emulators::DepositionGrid& grid);
+    void record_landing_edges(const std::vector<emulators::LandingEdge>& edges);
+    // Outcome and digest into meta, commit, close; returns the hex SHA-256.
+    // Later calls return the same digest.
+    std::string finish(const TraceOutcome& outcome);
+    bool finished() const { return db_ == nullptr && !sha256_.empty(); }
+    std::uint64_t sample_count() const { return rows_; }
+    // The last instant a sample was appended at (for an unfinished file's end).
+    TimeNs last_t_ns() const { return last_t_ns_; }
+
+private:
+    void exec(const char* sql);
+    void digest(const std::string& canonical);
+
+    std::filesystem::path file_;
+    sqlite3* db_ = nullptr;
+    sqlite3_stmt* insert_ = nullptr;
+    evp_md_ctx_st* digest_ = nullptr;
+    std::uint64_t rows_ = 0;
+    std::uint64_t rows_in_batch_ = 0;
+    TimeNs last_t_ns_ = 0;
+    std::string digest_text_;  // the digest, once computed (finish may be retried)
+    std::string sha256_;       // set once the file is closed
+};
+
+}  // namespace rig::harness

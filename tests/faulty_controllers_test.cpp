@@ -1,0 +1,200 @@
+// The catalogue of faulty controllers (cases/faulty-controllers/,
+// docs/faulty-controllers.md) as whole runs through `rig run` (harness +
+// rig-controller over DDS on loopback), on the first of its seeds (the demo runs
+// all five): every faulty controller must fail exactly as its `expect` says, the
+// controls must pass, `rig judge --check` must reproduce every metric from the
+// traces, and a faulty case without its expectation must fail the run.
+#include <gtest/gtest.h>
+
+#include "run_support.h"
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kCatalogue = fs::path(RIG_SOURCE_DIR) / "cases" / "faulty-controllers";
+
+fs::path fresh_dir(const std::string& name) {
+    return rig::testing::fresh_dir("faulty-controllers-" + std::to_string(::getpid()) + "-" + name);
+}
+
+using rig::testing::read_all;
+
+using rig::testing::read_all_command;
+
+// Runs `rig ARGS` with its output in `log`; returns the exit status (-1 if it did not exit normally).
+int rig(const std::string& args, const fs::path& log) {
+    const std::string command =
+        "timeout -k 10 600 '" RIG_BINARY_DIR "/bin/rig' " + args + " > '" + log.string() + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+int rig_run(const fs::path& target, const fs::path& out, const fs::path& log, const std::string& extra = "") {
+    return rig("run '" + target.string() + "' --out '" + out.string() + "' " + extra, log);
+}
+
+nlohmann::json load_results(const fs::path& out) {
+    std::ifstream in(out / "results.json");
+    if (!in) {
+        ADD_FAILURE() << "no results.json in " << out;
+        return nlohmann::json::object();
+    }
+    return nlohmann::json::parse(in);
+}
+
+const nlohmann::json* find_case(const nlohmann::json& results, const std::string& name) {
+    for (const auto& c : results.at("cases")) {
+        if (c.at("name") == name) return &c;
+    }
+    return nullptr;
+}
+
+// The metric each failure line names ("missed_m 0.42 > 0" -> "missed_m").
+std::set<std::string> failing_metrics(const nlohmann::json& one_case) {
+    std::set<std::string> metrics;
+    for (const auto& failure : one_case.at("failures")) {
+        const std::string line = failure.get<std::string>();
+        metrics.insert(line.substr(0, line.find(' ')));
+    }
+    return metrics;
+}
+
+TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
+    const fs::path out = fresh_dir("catalogue");
+    const int status = rig_run(kCatalogue, out / "run", out / "rig.log", "--seed 1 --jobs 2");
+    ASSERT_EQ(status, 0) << "rig run cases/faulty-controllers --seed 1:\n" << read_all(out / "rig.log");
+    const nlohmann::json results = load_results(out / "run");
+    EXPECT_EQ(results.at("summary").at("failed"), 0);
+
+    // Expected signature of every faulty controller: the metrics it breaks, or its error.
+    const std::map<std::string, std::set<std::string>> broken = {
+        {"never-resumes", {"missed_m", "flow_adjust_time_s", "flow_error_pct"}},
+        {"never-sprays", {"missed_m", "flow_adjust_time_s", "flow_error_pct"}},
+        {"sections-flicker", {"missed_m", "flow_adjust_time_s", "flow_error_pct"}},
+        {"no-hysteresis-compensation", {"missed_m"}},
+        {"opens-twice-as-early", {"overlap_m"}},
+        {"valve-held", {"flow_adjust_time_s", "flow_error_pct"}},
+        {"pid-gains-x5", {"flow_adjust_time_s", "flow_error_pct"}},
+        {"wrong-pulses-per-litre", {"flow_adjust_time_s", "flow_error_pct"}},
+        {"wrong-l4", {"breakpoint_store_error_m"}},
+        {"stale-fix-through-dropout", {"breakpoint_error_m"}},
+    };
+    const std::map<std::string, std::string> errors = {
+        {"crashes-mid-case", "node_exited"},
+        {"stops-answering", "node_unresponsive"},
+        {"reads-truth-topic", "topic_role_violation"},
+        {"forges-truth-topic", "topic_role_violation"},
+    };
+    ASSERT_EQ(results.at("cases").size(), broken.size() + errors.size() + 3) << results.dump(2);
+    for (const auto& [name, metrics] : broken) {
+        const nlohmann::json* one = find_case(results, name + "-seed1");
+        ASSERT_NE(one, nullptr) << name;
+        EXPECT_TRUE(one->at("passed").get<bool>()) << one->dump(2);
+        EXPECT_TRUE(one->at("expected_failure").get<bool>()) << name;
+        EXPECT_EQ(failing_metrics(*one), metrics) << one->dump(2);
+        EXPECT_TRUE(one->at("error").is_null()) << one->dump(2);
+    }
+    for (const auto& [name, kind] : errors) {
+        const nlohmann::json* one = find_case(results, name + "-seed1");
+        ASSERT_NE(one, nullptr) << name;
+        EXPECT_TRUE(one->at("passed").get<bool>()) << one->dump(2);
+        EXPECT_EQ(one->at("error_kind"), kind) << one->dump(2);
+    }
+    for (const char* control : {"reference-controller-seed1", "reference-controller-identification-seed1",
+                                "reference-controller-calibration-gap-seed1"}) {
+        const nlohmann::json* one = find_case(results, control);
+        ASSERT_NE(one, nullptr) << control;
+        EXPECT_TRUE(one->at("passed").get<bool>()) << one->dump(2);
+        EXPECT_FALSE(one->at("expected_failure").get<bool>()) << control;
+    }
+
+    // Not near misses: the span after the breakpoint (to the strip's end, 9 m
+    // past it) is missed by the controller that never resumes, the whole 33 m
+    // strip by the one that never sprays.
+    EXPECT_NEAR(find_case(results, "never-resumes-seed1")->at("metrics").at("missed_m").get<double>(), 9.0, 0.1);
+    EXPECT_NEAR(find_case(results, "never-sprays-seed1")->at("metrics").at("missed_m").get<double>(), 33.0, 0.1);
+    EXPECT_GT(find_case(results, "stale-fix-through-dropout-seed1")->at("metrics").at("breakpoint_error_m").get<double>(), 1.0);
+    // Role violations name the topic and the participant.
+    const std::string reader_error = find_case(results, "reads-truth-topic-seed1")->at("error").get<std::string>();
+    EXPECT_NE(reader_error.find("node 'controller': reads truth topic truth/vehicle"), std::string::npos) << reader_error;
+    const std::string forger_error = find_case(results, "forges-truth-topic-seed1")->at("error").get<std::string>();
+    EXPECT_NE(forger_error.find("node 'controller': writes truth topic truth/hydraulics"), std::string::npos)
+        << forger_error;
+
+    // The crashed controller's trace keeps every sample up to the crash (20 s), and says why it ends.
+    const fs::path crashed = out / "run" / "cases" / "crashes-mid-case-seed1" / "trace.sqlite";
+    const std::string rows = read_all_command("sqlite3 '" + crashed.string() +
+                                              "' \"select count(*), max(t_ns) from samples; "
+                                              "select value from meta where key in ('outcome', 'error_kind') order by key\"");
+    std::istringstream lines(rows);
+    std::string counts, error_kind, outcome;
+    std::getline(lines, counts);
+    std::getline(lines, error_kind);
+    std::getline(lines, outcome);
+    const auto bar = counts.find('|');
+    ASSERT_NE(bar, std::string::npos) << rows;
+    EXPECT_GT(std::stoll(counts.substr(0, bar)), 5000) << rows;
+    EXPECT_NEAR(static_cast<double>(std::stoll(counts.substr(bar + 1))) / 1e9, 20.0, 0.05) << rows;
+    EXPECT_EQ(outcome, "error");
+    EXPECT_EQ(error_kind, "node_exited");
+
+    // Re-judging the traces alone gives every metric, verdict and digest exactly.
+    const int rejudged = rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",
+                             out / "judge.log");
+    EXPECT_EQ(rejudged, 0) << read_all(out / "judge.log");
+    EXPECT_NE(read_all(out / "judge.log").find("re-judged: every metric, verdict and digest as recorded"),
+              std::string::npos)
+        << read_all(out / "judge.log");
+    EXPECT_EQ(load_results(out / "rejudged").at("cases").size(), results.at("cases").size());
+}
+
+TEST(FaultyControllers, ANoCompensationControllerWithoutItsExpectationFailsTheRun) {
+    const fs::path out = fresh_dir("unexpected");
+    // The same case file without its `expect:` line.
+    const std::string original = read_all(kCatalogue / "no-hysteresis-compensation.yaml");
+    std::istringstream lines(original);
+    std::ostringstream stripped;
+    int removed = 0;
+    for (std::string line; std::getline(lines, line);) {
+        if (line.rfind("expect:", 0) == 0) {
+            ++removed;
+            continue;
+        }
+        stripped << line << '\n';
+    }
+    ASSERT_EQ(removed, 1) << "the case file no longer has one top-level expect: line";
+    const fs::path case_file = out / "no-compensation-unexpected.yaml";
+    std::ofstream(case_file) << stripped.str();
+
+    const int status = rig_run(case_file, out / "run", out / "rig.log", "--seed 1");
+    EXPECT_EQ(status, 1) << "rig run must fail:\n" << read_all(out / "rig.log");
+    const nlohmann::json results = load_results(out / "run");
+    ASSERT_EQ(results.at("cases").size(), 1u) << results.dump(2);
+    const nlohmann::json& only = results.at("cases").at(0);
+    EXPECT_EQ(only.at("passed"), false);
+    EXPECT_EQ(only.at("expected_failure"), false);
+    EXPECT_EQ(results.at("summary").at("failed"), 1);
+    const std::regex missed(R"(missed_m [0-9.eE+-]+ > 0)");
+    const auto& failures = only.at("failures");
+    EXPECT_TRUE(std::any_of(failures.begin(), failures.end(),
+                            [&](const nlohmann::json& f) { return std::regex_match(f.get<std::string>(), missed); }))
+        << only.dump(2);
+}
+
+}  // namespace

@@ -1,0 +1,338 @@
+// The judge on hand-made traces (harness/judge.h, harness/trace_file.h): a
+// trace written row by row, without DDS or a plant, then read back and judged
+// as `rig judge` does. Each test builds the trace of a controller behaviour the
+// judge must not be fooled by, and checks the verdict names the right metric or
+// error:
+//  * never resumes after the breakpoint: missed = the span after it;
+//  * never sprays: missed = the whole strip;
+//  * flickering sections: the flow never settles (no small adjust time);
+//  * a truth reader, a truth forger: the case fails naming topic and participant;
+//  * a killed controller: the trace keeps its samples, the error its kind;
+//  * a trace edited after its run, or not a trace at all: refused, not judged.
+#include <gtest/gtest.h>
+
+#include "run_support.h"
+
+#include <sqlite3.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "emulators/deposition_grid.h"
+#include "harness/judge.h"
+#include "harness/trace_file.h"
+#include "idl/topics.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using rig::TimeNs;
+using namespace rig::harness;
+
+constexpr TimeNs kMs = 1'000'000;
+constexpr TimeNs kS = 1'000'000'000;
+constexpr double kNominal = 20.0 / 60.0 / (6.0 / 3.6 * 12.2) * 100.0;  // 20 L/min, 6 km/h, 12.2 m: uL/cm^2
+
+// A continuation at 6 km/h with the breakpoint at 0: the first pass from -25 m,
+// the continuation pass (pass 1) from 30 s, the strip -24..+9 m.
+JudgingPlan continuation_plan() {
+    JudgingPlan plan;
+    plan.scenario = "breakpoint_continuation";
+    plan.breakpoint_along_m = 0.0;
+    plan.field_origin_lat_deg = 40.18;
+    plan.field_origin_lon_deg = 116.44;
+    plan.field_heading_deg = 90.0;
+    plan.judge_breakpoint = true;
+    plan.judge_flow = true;
+    plan.flow = FlowJudging{20.0, 3.0, 1.7};
+    plan.flow_window = FlowWindow{30 * kS, 55 * kS};
+    plan.judge_deposition = true;
+    plan.deposition.nominal_dose_ul_cm2 = kNominal;
+    plan.deposition.strip_from_m = -24.0;
+    plan.deposition.strip_to_m = 9.0;
+    plan.limits = {{"breakpoint_error_m", 0.2}, {"flow_adjust_time_s", 1.7}, {"flow_error_pct", 3.0},
+                   {"overlap_m", 3.3},          {"missed_m", 0.0}};
+    return plan;
+}
+
+// A trace file being written by hand.
+class HandMadeTrace {
+public:
+    HandMadeTrace(const std::string& name, const JudgingPlan& plan)
+        : dir_(rig::testing::fresh_dir("judge-" + name)), trace_(dir_ / "trace.sqlite") {
+        trace_.set_meta("case", name);
+        trace_.set_meta("case_file", "hand-made/" + name + ".yaml");
+        trace_.set_meta("seed", "1");
+        trace_.set_meta("mode", "lockstep");
+        trace_.set_meta("judging", to_json(plan).dump());
+    }
+    TraceFile& trace() { return trace_; }
+    fs::path path() const { return dir_ / "trace.sqlite"; }
+
+    // The vehicle: nozzle line along the track at 6 km/h, the first pass from
+    // -25 m at 0 s to the breakpoint, the continuation from -8 m at 30 s.
+    void drive() {
+        for (TimeNs t = 0; t <= 60 * kS; t += 50 * kMs) {
+            const double t_s = rig::ns_to_seconds(t);
+            const bool second = t >= 30 * kS;
+            const double along_m = second ? -8.0 + (t_s - 30.0) * 6.0 / 3.6 : std::min(0.0, -25.0 + t_s * 6.0 / 3.6);
+            trace_.append(t, 0, rig::topics::kVehicleTruth,
+                          {{"nozzle_line_along_m", along_m}, {"pass_index", second ? 1 : 0}});
+        }
+    }
+    // Section commands, and the hydraulics truth every 10 ms from 25 s to 60 s.
+    void section_command(TimeNs t, int mask) {
+        trace_.append(t, 0, rig::topics::kSectionValves, {{"open_mask", mask}});
+    }
+    void hydraulics(const std::function<double(TimeNs)>& flow, const std::function<bool(TimeNs)>& spraying) {
+        for (TimeNs t = 25 * kS; t < 60 * kS; t += 10 * kMs) {
+            trace_.append(t, 0, rig::topics::kHydraulicsTruth,
+                          {{"main_flow_l_min", flow(t)}, {"sections_spraying_mask", spraying(t) ? 7 : 0}});
+        }
+    }
+    void breakpoint_reached(TimeNs t) {
+        trace_.append(t, 0, rig::topics::kBreakpointEvent, {{"kind", "reached"}, {"lat_deg", nullptr}, {"lon_deg", nullptr}});
+    }
+    // The nominal dose on every row of [from_m, to_m) in `pass`.
+    void spray(int pass, double from_m, double to_m) {
+        for (double along_m = from_m + 0.025; along_m < to_m; along_m += 0.05) {
+            for (int nozzle = 0; nozzle < 22; ++nozzle) {
+                grid_.deposit(pass, nozzle, along_m, kNominal * cell_area_cm2() / 1e6);
+            }
+        }
+    }
+    void finish(const TraceOutcome& outcome = TraceOutcome{"completed", "", "", 60 * kS}) {
+        grid_.deposit(1, 0, -44.0, 0.0);  // both passes exist in the grid
+        trace_.record_deposition(grid_);
+        trace_.finish(outcome);
+    }
+    CaseRun judged() { return judge_trace(read_trace(path())); }
+
+private:
+    static rig::emulators::DepositionGridParams grid_params() {
+        rig::emulators::DepositionGridParams params;
+        params.from_along_m = -45.0;
+        params.to_along_m = 15.0;
+        params.cell_along_m = 0.05;
+        params.footprint_along_m = 0.05;  // one cell: the dose lands where it is put
+        return params;
+    }
+    static double cell_area_cm2() { return 5.0 * 12.2 / 22.0 * 100.0; }
+
+    fs::path dir_;
+    TraceFile trace_;
+    rig::emulators::DepositionGrid grid_{grid_params()};
+};
+
+bool has_failure_starting(const CaseResult& result, const std::string& prefix) {
+    for (const std::string& failure : result.failures) {
+        if (failure.rfind(prefix, 0) == 0) return true;
+    }
+    return false;
+}
+
+TEST(Judge, NeverResumingMissesTheWholeSpanAfterTheBreakpoint) {
+    HandMadeTrace made("never-resumes", continuation_plan());
+    made.drive();
+    made.section_command(0, 0);
+    made.breakpoint_reached(35 * kS);
+    made.hydraulics([](TimeNs) { return 0.0; }, [](TimeNs) { return false; });
+    made.spray(0, -24.5, 0.0);  // the first pass up to the breakpoint, then nothing
+    made.finish();
+    const CaseResult result = made.judged().result;
+    EXPECT_FALSE(result.passed);
+    EXPECT_NEAR(result.metrics.at("missed_m"), 9.0, 1e-9) << "from the breakpoint to the strip's end";
+    EXPECT_TRUE(has_failure_starting(result, "missed_m 9 > 0")) << testing::PrintToString(result.failures);
+    EXPECT_TRUE(has_failure_starting(result, "flow_adjust_time_s not measured: never settled: the sections never opened"))
+        << testing::PrintToString(result.failures);
+}
+
+TEST(Judge, NeverSprayingMissesTheWholeStrip) {
+    HandMadeTrace made("never-sprays", continuation_plan());
+    made.drive();
+    made.section_command(0, 0);
+    made.hydraulics([](TimeNs) { return 0.0; }, [](TimeNs) { return false; });
+    made.finish();
+    const CaseResult result = made.judged().result;
+    EXPECT_FALSE(result.passed);
+    EXPECT_NEAR(result.metrics.at("missed_m"), 33.0, 1e-9);
+    EXPECT_EQ(result.metrics.at("overlap_m"), 0.0);
+    EXPECT_TRUE(has_failure_starting(result, "breakpoint_error_m not measured: never declared"))
+        << testing::PrintToString(result.failures);
+}
+
+TEST(Judge, FlickeringSectionsNeverSettleAndGetNoSmallAdjustTime) {
+    JudgingPlan plan = continuation_plan();
+    plan.judge_deposition = false;
+    HandMadeTrace made("flicker", plan);
+    made.drive();
+    made.section_command(0, 0);
+    // Open at 40 s; shut for 50 ms every 0.5 s after (the valves follow 0.2 s
+    // later and the line refills over 0.8 s each time).
+    made.section_command(40 * kS, 7);
+    for (TimeNs t = 40500 * kMs; t < 55 * kS; t += 500 * kMs) {
+        made.section_command(t, 0);
+        made.section_command(t + 50 * kMs, 7);
+    }
+    auto shut = [](TimeNs t) { return t < 40200 * kMs || (t >= 40700 * kMs && (t - 40700 * kMs) % (500 * kMs) < 50 * kMs); };
+    auto flow = [&](TimeNs t) {
+        if (shut(t)) return 0.0;
+        const TimeNs since = t < 40700 * kMs ? t - 40200 * kMs : (t - 40700 * kMs) % (500 * kMs) - 50 * kMs;
+        return 20.0 * std::min(1.0, static_cast<double>(since) / (800.0 * kMs));
+    };
+    made.hydraulics(flow, [&](TimeNs t) { return !shut(t); });
+    made.breakpoint_reached(42 * kS);
+    made.finish();
+    const CaseResult result = made.judged().result;
+    EXPECT_FALSE(result.passed);
+    EXPECT_EQ(result.metrics.count("flow_adjust_time_s"), 0u) << "a flickering flow has no adjust time";
+    ASSERT_EQ(result.not_measured.count("flow_adjust_time_s"), 1u);
+    EXPECT_NE(result.not_measured.at("flow_adjust_time_s").find("never settled"), std::string::npos);
+    EXPECT_TRUE(has_failure_starting(result, "flow_adjust_time_s not measured: never settled"));
+    EXPECT_GT(result.metrics.at("flow_error_pct"), 3.0);
+}
+
+TEST(Judge, ATruthReaderFailsTheCaseNamingTopicAndParticipant) {
+    HandMadeTrace made("truth-reader", continuation_plan());
+    made.drive();
+    made.trace().record_discoveries(
+        0, {rig::DiscoveredEndpoint{"controller", "010f0a0b0c0d0e0f00000000", "device/gnss/nmea", "NmeaSentence", false, false},
+            rig::DiscoveredEndpoint{"controller", "010f0a0b0c0d0e0f00000000", "truth/vehicle", "VehicleTruth", false, false}});
+    made.finish();
+    const CaseResult result = made.judged().result;
+    EXPECT_FALSE(result.passed);
+    EXPECT_EQ(result.error_kind, "topic_role_violation");
+    EXPECT_NE(result.error.find("reads truth topic truth/vehicle"), std::string::npos) << result.error;
+    EXPECT_NE(result.error.find("participant 'controller'"), std::string::npos) << result.error;
+    // The same trace with the error expected passes as such.
+    JudgingPlan expecting = continuation_plan();
+    expecting.expect_error = "topic_role_violation";
+    HandMadeTrace again("truth-reader-expected", expecting);
+    again.trace().record_discoveries(
+        0, {rig::DiscoveredEndpoint{"controller", "010f0a0b0c0d0e0f00000000", "truth/vehicle", "VehicleTruth", false, false}});
+    again.finish();
+    const CaseResult expected = again.judged().result;
+    EXPECT_TRUE(case_passed(expected)) << testing::PrintToString(expected.failures);
+    EXPECT_TRUE(expected.expected_failure);
+}
+
+TEST(Judge, ForgedTruthIsNeverJudgedAndFailsTheCase) {
+    HandMadeTrace made("truth-forger", continuation_plan());
+    made.drive();
+    made.trace().append_foreign(45 * kS, 0, rig::topics::kHydraulicsTruth, "controller", "010f0a0b0c0d0e0f00000000",
+                                {{"main_flow_l_min", 20.0}, {"sections_spraying_mask", 7}});
+    made.finish();
+    const CaseRun run = made.judged();
+    EXPECT_EQ(run.result.error_kind, "topic_role_violation");
+    EXPECT_NE(run.result.error.find("truth/hydraulics"), std::string::npos) << run.result.error;
+    EXPECT_NE(run.result.error.find("'controller'"), std::string::npos) << run.result.error;
+    // The forged "flow on target" is not truth: the flow never opened.
+    EXPECT_EQ(run.result.metrics.count("flow_adjust_time_s"), 0u);
+}
+
+TEST(Judge, AKilledControllersTraceKeepsItsSamplesAndItsError) {
+    HandMadeTrace made("killed", continuation_plan());
+    made.drive();
+    made.section_command(0, 0);
+    made.finish(TraceOutcome{"error", "node_exited",
+                             "node 'controller': process killed by signal 6 (Aborted) (at t=20.000 s)", 20 * kS});
+    const RecordedTrace trace = read_trace(made.path());
+    EXPECT_EQ(trace.samples.at(rig::topics::kVehicleTruth).size(), 1201u) << "every sample written is there";
+    const CaseResult result = judge_trace(trace).result;
+    EXPECT_FALSE(case_passed(result));
+    EXPECT_EQ(result.error_kind, "node_exited");
+    EXPECT_EQ(result.sim_seconds, 20.0);
+    ASSERT_FALSE(result.failures.empty());
+    EXPECT_EQ(result.failures.front().rfind("error: node_exited: node 'controller': process killed", 0), 0u)
+        << result.failures.front();
+}
+
+TEST(Judge, AnUnfinishedTraceIsReadableAsInterrupted) {
+    const fs::path dir = rig::testing::fresh_dir("judge-unfinished");
+    {
+        TraceFile trace(dir / "trace.sqlite");
+        trace.set_meta("case", "unfinished");
+        trace.set_meta("judging", to_json(continuation_plan()).dump());
+        for (TimeNs t = 0; t < 10 * kS; t += 10 * kMs) trace.append(t, 0, "device/wheel_encoder/count", {{"count_pulses", t / kMs}});
+        // Destroyed unfinished, as when an exception unwinds past the run.
+    }
+    const RecordedTrace trace = read_trace(dir / "trace.sqlite");
+    EXPECT_EQ(trace.meta.at("outcome"), "interrupted");
+    const CaseResult result = judge_trace(trace).result;
+    EXPECT_EQ(result.error_kind, "interrupted");
+    EXPECT_NEAR(result.sim_seconds, 9.99, 1e-9);
+}
+
+TEST(Judge, ATraceChangedAfterItsRunIsNotJudgedAsTheRuns) {
+    HandMadeTrace made("edited", continuation_plan());
+    made.drive();
+    made.finish();
+    EXPECT_EQ(made.judged().result.error, "");
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(made.path().c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db,
+                           "UPDATE samples SET json = replace(json, '-25.0', '-24.0') WHERE rowid = 1",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+    const CaseResult result = made.judged().result;
+    EXPECT_EQ(result.error_kind, "harness_error");
+    EXPECT_NE(result.error.find("changed after the run"), std::string::npos) << result.error;
+}
+
+TEST(Judge, WhatIsNotATraceIsRefusedNamingIt) {
+    const fs::path dir = rig::testing::fresh_dir("judge-not-a-trace");
+    std::ofstream(dir / "notes.txt") << "not a database\n";
+    for (const fs::path& path : {dir / "notes.txt", dir / "missing.sqlite", dir}) {
+        try {
+            read_trace(path);
+            ADD_FAILURE() << path << " was read as a trace";
+        } catch (const std::runtime_error& error) {
+            EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+        }
+    }
+    // Another trace format: say so rather than misjudge it.
+    {
+        TraceFile trace(dir / "old.sqlite");
+        trace.set_meta("trace_format", "1");
+        trace.finish(TraceOutcome{});
+    }
+    try {
+        read_trace(dir / "old.sqlite");
+        ADD_FAILURE() << "a format-1 trace was read";
+    } catch (const std::runtime_error& error) {
+        EXPECT_NE(std::string(error.what()).find("trace format 1"), std::string::npos) << error.what();
+    }
+}
+
+TEST(JudgingPlan, RoundTripsThroughJsonAndNamesAMissingKey) {
+    const JudgingPlan plan = continuation_plan();
+    const JudgingPlan back = judging_plan_from_json(to_json(plan));
+    EXPECT_EQ(to_json(back), to_json(plan));
+    nlohmann::json broken = to_json(plan);
+    broken["flow"].erase("window_to_ns");
+    try {
+        judging_plan_from_json(broken);
+        ADD_FAILURE() << "accepted a plan without flow.window_to_ns";
+    } catch (const std::runtime_error& error) {
+        EXPECT_NE(std::string(error.what()).find("flow.window_to_ns"), std::string::npos) << error.what();
+    }
+}
+
+TEST(TopicRoles, TruthIsTheRigsDeviceDataTooTheClockToo) {
+    EXPECT_TRUE(topic_role_violation("reader", "truth/vehicle"));
+    EXPECT_TRUE(topic_role_violation("writer", "truth/hydraulics"));
+    EXPECT_TRUE(topic_role_violation("writer", "device/gnss/nmea"));
+    EXPECT_TRUE(topic_role_violation("writer", "rig/clock/tick"));
+    EXPECT_FALSE(topic_role_violation("reader", "device/gnss/nmea"));
+    EXPECT_FALSE(topic_role_violation("writer", "actuator/section_valves/open"));
+    EXPECT_FALSE(topic_role_violation("writer", "controller/status"));
+    EXPECT_FALSE(topic_role_violation("writer", "rig/clock/ack"));
+    EXPECT_FALSE(topic_role_violation("writer", "team/diagnostics"));  // a controller's own topic
+}
+
+}  // namespace
