@@ -41,10 +41,15 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
             try {
                 specs.push_back(load_case_file(path));
                 validate_for_run(specs.back(), options);
+                // Dropouts and episodes against the case's length, which only its route gives.
+                const CaseWorld world = build_case_world(specs.back(), specs.back().seed);
+                check_case_timeline(specs.back(), rig::ns_to_seconds(world.end_ns), world.breakpoint_crossing_s);
             } catch (const std::exception& error) {
                 errors.push_back(error.what());
             }
         }
+        // Two cases with one name would write the same cases/NAME/.
+        for (const std::string& error : duplicate_case_name_errors(specs)) errors.push_back(error);
         if (!errors.empty()) {
             for (const auto& error : errors) std::cerr << "rig: " << error << "\n";
             std::cerr << "rig: " << errors.size() << " case file error(s); nothing was run\n";
@@ -76,12 +81,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
 
 int nmea_decode_command(const std::string& input) {
     if (input == "-") return rig::nmea::decode_stream(std::cin, std::cout);
-    std::ifstream file(input, std::ios::binary);
-    if (!file) {
-        std::cerr << "rig nmea decode: cannot open " << input << "\n";
-        return 2;
-    }
-    return rig::nmea::decode_stream(file, std::cout);
+    return rig::nmea::decode_file(input, std::cout, std::cerr);
 }
 
 }  // namespace
