@@ -359,6 +359,17 @@ void BreakpointStore::save() const {
     if (::fsync(directory.get()) != 0) throw_errno("fsync directory " + directory_.string());
 }
 
+std::string format_store_text(const StoreText& contents) { return serialize(contents.breakpoints, contents.next_id); }
+
+StoreText parse_store_text(std::string_view text) {
+    try {
+        StoreContents contents = parse(text);
+        return StoreText{std::move(contents.breakpoints), contents.next_id};
+    } catch (const CorruptStore& corrupt) {
+        throw BreakpointStoreError("(text)", corrupt.line, corrupt.problem, {});
+    }
+}
+
 std::string breakpoint_store_name_problem(std::string_view name) {
     // Room for the ".corrupt-N" and ".tmp" siblings within NAME_MAX (255).
     return plain_file_name_problem(name, 200);

@@ -119,6 +119,16 @@ private:
     std::uint32_t next_id_ = 1;
 };
 
+// A store file's text, as save() writes it and load() reads it (without the
+// file): for tests and the fuzzer. parse_store_text() throws
+// BreakpointStoreError (file "(text)", no kept_as) naming the line.
+struct StoreText {
+    std::vector<StoredBreakpoint> breakpoints;
+    std::uint32_t next_id = 1;
+};
+std::string format_store_text(const StoreText& contents);
+StoreText parse_store_text(std::string_view text);
+
 // CRC-32 as in IEEE 802.3 / zlib (reflected polynomial 0xEDB88320, initial and
 // final XOR 0xFFFFFFFF); crc32_ieee("123456789") == 0xCBF43926.
 std::uint32_t crc32_ieee(std::string_view bytes);
