@@ -501,15 +501,16 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     const YamlSection expect = root.section("expect");
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
         const std::string& metric = spec.expect.fail[index];
+        const std::string shown = metric.size() > 64 ? metric.substr(0, 64) + "..." : metric;
         if (!spec.limits.contains(metric) &&
             !(default_limits.contains(metric) && default_limit_applies(spec.scenario, metric))) {
             throw ConfigError(expect.item_location("fail", index),
-                              "'" + metric + "' has no limit; expected failures must name limited metrics "
+                              "'" + shown + "' has no limit; expected failures must name limited metrics "
                               "(limits in this file or the defaults)");
         }
         for (std::size_t earlier = 0; earlier < index; ++earlier) {
             if (spec.expect.fail[earlier] == metric) {
-                throw ConfigError(expect.item_location("fail", index), "'" + metric + "' is listed twice");
+                throw ConfigError(expect.item_location("fail", index), "'" + shown + "' is listed twice");
             }
         }
     }

@@ -2,6 +2,9 @@
 
 #include "rig/file_access.h"
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -59,11 +62,23 @@ SourceLocation location_at(const std::string& file, const YAML::Mark& mark, std:
     return where;
 }
 
+// A key as messages show it: one line, at most kMaxQuotedKeyChars (a key can
+// be a multi-line scalar of any length; an error must stay one short line).
+constexpr std::size_t kMaxQuotedKeyChars = 64;
+std::string shown_key(std::string_view key) {
+    std::string text(key.substr(0, kMaxQuotedKeyChars));
+    for (char& c : text) {
+        if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    }
+    if (key.size() > kMaxQuotedKeyChars) text += "...";
+    return text;
+}
+
 std::string child_path(const std::string& parent, std::string_view key) {
-    if (parent.empty()) return std::string(key);
+    if (parent.empty()) return shown_key(key);
     std::string path = parent;
     path += '.';
-    path += key;
+    path += shown_key(key);
     return path;
 }
 
@@ -167,7 +182,7 @@ private:
             if (!inserted) {
                 const YAML::Mark& earlier_mark = earlier->second;
                 throw ConfigError(location_at(file_, key.Mark(), key_path),
-                                  "duplicate key '" + name + "' (first at line " + std::to_string(earlier_mark.line + 1) +
+                                  "duplicate key '" + shown_key(name) + "' (first at line " + std::to_string(earlier_mark.line + 1) +
                                       ", column " + std::to_string(earlier_mark.column + 1) + ")");
             }
             check(value, key_path);
@@ -178,6 +193,58 @@ private:
     std::vector<YAML::Node> ancestors_;
     std::size_t visited_ = 0;
 };
+
+// Counts a text's documents without building them, for at most two.
+//
+// Not YAML::LoadAll: in yaml-cpp 0.7 (Debian 12) a ',' outside [ ] or { } at
+// the top level (",", "[1]\n,") makes each HandleNextDocument() return an
+// empty document without consuming the ','; LoadAll then loops forever,
+// allocating (found by tests/fuzz/case_file_fuzz). A document that starts
+// where the previous one did is that: reported as a syntax error there.
+class DocumentCounter : public YAML::EventHandler {
+public:
+    void OnDocumentStart(const YAML::Mark& mark) override { start = mark; }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+    void OnMapEnd() override {}
+    YAML::Mark start = YAML::Mark::null_mark();
+};
+
+struct DocumentCount {
+    int documents = 0;
+    YAML::Mark second_start = YAML::Mark::null_mark();
+};
+
+DocumentCount count_documents(const std::string& text, const std::string& file_name) {
+    std::istringstream in(text);
+    DocumentCount count;
+    try {
+        YAML::Parser parser(in);
+        DocumentCounter counter;
+        YAML::Mark previous = YAML::Mark::null_mark();
+        // Up to three, so a stuck ',' after a first document is told from a real second one.
+        while (count.documents < 3 && parser.HandleNextDocument(counter)) {
+            if (count.documents >= 1) {
+                if (counter.start.pos == previous.pos) {
+                    throw ConfigError(location_at(file_name, counter.start, ""),
+                                      "YAML syntax error: a ',' outside [ ] or { } (or another token that "
+                                      "starts no value)");
+                }
+                if (count.documents == 1) count.second_start = counter.start;
+            }
+            previous = counter.start;
+            ++count.documents;
+        }
+    } catch (const YAML::Exception& error) {
+        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
+    }
+    return count;
+}
 
 template <class T>
 constexpr std::string_view expected_kind() {
@@ -491,7 +558,7 @@ void collect_unknown_keys(const YamlSection::State& state, std::vector<UnknownKe
 ConfigError unknown_key_error(const UnknownKey& unknown) {
     const YamlSection::State& state = *unknown.state;
     const std::string& key = unknown.entry->key;
-    std::string message = "unknown key '" + key + "'";
+    std::string message = "unknown key '" + shown_key(key) + "'";
     if (state.known_keys.empty()) {
         message += "; nothing is allowed here";
     } else if (const auto suggestion = closest_spelling(key, state.known_keys)) {
@@ -537,21 +604,22 @@ YamlSection::YamlSection(const RawYaml& raw) : YamlSection(raw.node, raw.locatio
 }
 
 YamlSection YamlSection::load_string(std::string_view yaml_text, const std::string& file_name) {
-    std::vector<YAML::Node> documents;
-    try {
-        documents = YAML::LoadAll(std::string(yaml_text));
-    } catch (const YAML::Exception& error) {
-        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
-    }
-    if (documents.empty()) {
+    const std::string text(yaml_text);
+    const DocumentCount count = count_documents(text, file_name);
+    if (count.documents == 0) {
         throw ConfigError(SourceLocation{file_name, 1, 1, ""},
                           "the file is empty; expected a mapping of settings (key: value lines)");
     }
-    if (documents.size() > 1) {
-        throw ConfigError(location_at(file_name, documents[1].Mark(), ""),
+    if (count.documents > 1) {
+        throw ConfigError(location_at(file_name, count.second_start, ""),
                           "a second YAML document ('---') in the file; one file holds one document");
     }
-    const YAML::Node& root = documents.front();
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);  // the first document only: never LoadAll's loop
+    } catch (const YAML::Exception& error) {
+        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
+    }
     if (!root.IsMap()) {
         throw ConfigError(location_at(file_name, root.IsNull() ? YAML::Mark{} : root.Mark(), ""),
                           "expected a mapping of settings (key: value lines) at the top level, got " +
