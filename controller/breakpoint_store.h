@@ -24,6 +24,13 @@
 //
 // A corrupt FILE is never dropped: load() renames it to FILE.corrupt-N (the first
 // N from 1 that is free) and throws BreakpointStoreError naming the file and line.
+//
+// Confinement: FILE is DIR/NAME with NAME a plain file name (no '/', not '.' or
+// '..'; breakpoint_store_name_problem()); every file the store touches (NAME,
+// NAME.tmp, NAME.corrupt-N) is opened or renamed relative to DIR, without
+// following a symbolic link. Only a regular file of at most kMaxStoreBytes is
+// read: anything else (a FIFO, a device, a directory, a symlink, a larger file)
+// is refused with BreakpointStoreFileError and left as it is.
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
@@ -32,6 +39,14 @@
 #include <vector>
 
 namespace rig::controller {
+
+// A store holds the breakpoints of unfinished rows: a handful in the field.
+// 32 MiB is over 700,000 records, far beyond any, and bounds the memory and
+// time a wrong file can take.
+inline constexpr std::uint64_t kMaxStoreBytes = 32u << 20;
+
+// Empty when `name` can be a store file name (a plain name, see above), else why not.
+std::string breakpoint_store_name_problem(std::string_view name);
 
 struct StoredBreakpoint {
     std::uint32_t id = 0;
@@ -60,14 +75,23 @@ private:
     std::filesystem::path kept_as_;
 };
 
+// A store file that is not a store at all (not a regular file, too large) or
+// cannot be read. what(): "breakpoint store FILE: is a FIFO (named pipe), ...".
+class BreakpointStoreFileError : public std::runtime_error {
+public:
+    BreakpointStoreFileError(const std::filesystem::path& file, const std::string& problem);
+};
+
 class BreakpointStore {
 public:
-    // Nothing is read until load(); a new store is empty.
+    // Nothing is read until load(); a new store is empty. Throws
+    // std::invalid_argument when file's name is not a plain file name.
     explicit BreakpointStore(std::filesystem::path file);
 
     // Replaces the contents with the file's. A missing file is an empty store.
-    // A corrupt one is moved aside and BreakpointStoreError is thrown; the
-    // in-memory contents are then unchanged. I/O failures throw std::system_error.
+    // A corrupt one is moved aside and BreakpointStoreError is thrown; one that
+    // is no store file, BreakpointStoreFileError; the in-memory contents are
+    // then unchanged. I/O failures throw std::system_error.
     void load();
 
     // Appends a breakpoint with the next free id and returns it (course wrapped
@@ -89,9 +113,21 @@ public:
 
 private:
     std::filesystem::path file_;
+    std::filesystem::path directory_;  // file_'s directory ("" = the current one)
+    std::string name_;                 // file_'s name in it
     std::vector<StoredBreakpoint> breakpoints_;
     std::uint32_t next_id_ = 1;
 };
+
+// A store file's text, as save() writes it and load() reads it (without the
+// file): for tests and the fuzzer. parse_store_text() throws
+// BreakpointStoreError (file "(text)", no kept_as) naming the line.
+struct StoreText {
+    std::vector<StoredBreakpoint> breakpoints;
+    std::uint32_t next_id = 1;
+};
+std::string format_store_text(const StoreText& contents);
+StoreText parse_store_text(std::string_view text);
 
 // CRC-32 as in IEEE 802.3 / zlib (reflected polynomial 0xEDB88320, initial and
 // final XOR 0xFFFFFFFF); crc32_ieee("123456789") == 0xCBF43926.

@@ -12,6 +12,12 @@
 #include <nlohmann/json.hpp>
 
 #include "controller/nmea_parser.h"
+#include "rig/file_access.h"
+
+#include <fcntl.h>
+
+#include <cstring>
+#include <limits>
 
 namespace rig::nmea {
 namespace {
@@ -189,6 +195,27 @@ int decode_stream(std::istream& in, std::ostream& out) {
         }
     }
     return all_decoded ? 0 : 1;
+}
+
+int decode_file(const std::filesystem::path& file, std::ostream& out, std::ostream& err) {
+    // Streamed line by line, so any size is fine.
+    const OpenOptions options{.no_follow = false, .max_bytes = std::numeric_limits<std::uint64_t>::max(),
+                              .what = "NMEA capture"};
+    try {
+        const FileDescriptor fd = open_regular_file(AT_FDCWD, file, options, file);
+        FdInputBuffer buffer(fd.get());
+        std::istream in(&buffer);
+        const int status = decode_stream(in, out);
+        if (buffer.read_error() != 0) {
+            err << "rig nmea decode: " << file.string() << ": read error: " << std::strerror(buffer.read_error())
+                << "\n";
+            return 2;
+        }
+        return status;
+    } catch (const FileAccessError& error) {
+        err << "rig nmea decode: " << error.what() << "\n";
+        return 2;
+    }
 }
 
 }  // namespace rig::nmea

@@ -2,6 +2,7 @@
 // a gpsd regression log) into one JSON object per line, for people and scripts.
 #pragma once
 
+#include <filesystem>
 #include <iosfwd>
 
 namespace rig::nmea {
@@ -15,5 +16,12 @@ namespace rig::nmea {
 // nothing.  Lines of any length and any bytes are fine.
 // Returns 0 if every non-skipped line decoded, 1 otherwise.
 int decode_stream(std::istream& in, std::ostream& out);
+
+// `rig nmea decode FILE`: decode_stream() over a regular file. A directory, a
+// FIFO, a device or a missing file is refused with one line on `err` naming
+// the path and what it is ("rig nmea decode: x: is a directory, expected a
+// regular file (NMEA capture)"), exit status 2; a FIFO would otherwise block
+// and a device never end. Standard input ("-") is decode_stream(std::cin, ...).
+int decode_file(const std::filesystem::path& file, std::ostream& out, std::ostream& err);
 
 }  // namespace rig::nmea

@@ -25,6 +25,7 @@ int run_emulate_gnss(const EmulateGnssOptions& options, std::ostream& out, std::
         const CaseSpec spec = load_case_file(options.case_file);
         const StopSignals stop;  // before any thread starts (DDS, pty forwarding)
         CaseWorld world = build_case_world(spec, options.seed.value_or(spec.seed));
+        check_case_timeline(spec, ns_to_seconds(world.end_ns), world.breakpoint_crossing_s);
 
         SerialSettings line;
         line.baud = options.baud;

@@ -1,12 +1,15 @@
 #include "harness/case_spec.h"
 
+#include "emulators/land_wheel.h"
+#include "rig/file_access.h"
 #include "rig/lockstep.h"
 #include "rig/modbus_protocol.h"
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <fstream>
+#include <cmath>
+#include <unordered_map>
 #include <optional>
 #include <sstream>
 #include <system_error>
@@ -66,11 +69,6 @@ std::string number_text(double value) {
     return std::string(buffer, result.ptr);
 }
 
-bool is_case_name(std::string_view name) {
-    return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '_' || c == '-';
-    });
-}
 
 // Fixed-width digits at text[pos, pos + count), or nullopt.
 std::optional<int> digits_at(std::string_view text, std::size_t pos, std::size_t count) {
@@ -99,6 +97,9 @@ std::optional<std::chrono::sys_time<std::chrono::nanoseconds>> parse_utc(std::st
     if (text.back() != 'Z') return std::nullopt;
     const year_month_day date{year{*year_value}, month{static_cast<unsigned>(*month_value)},
                               day{static_cast<unsigned>(*day_value)}};
+    // From the GPS epoch (1980) to 2099: RMC carries a two-digit year, and
+    // nanoseconds since 1970 in 64 bits end in 2262.
+    if (*year_value < 1980 || *year_value > 2099) return std::nullopt;
     if (!date.ok() || *hour_value > 23 || *minute_value > 59 || *second_value > 59) return std::nullopt;
 
     std::int64_t fraction_ns = 0;
@@ -117,12 +118,26 @@ std::optional<std::chrono::sys_time<std::chrono::nanoseconds>> parse_utc(std::st
 }
 
 // ---------------------------------------------------------------- sections
+//
+// Every number has a range, each with its physical reason: a finite value far
+// outside physics (1e300 m, a 1e-300 Hz rate) would pass a sign check and then
+// overflow simulated time (int64 ns) or allocate without end at run time.
+
+// A position along the A-B line (see kMaxAlongM).
+const Bounds kAlongBounds = Bounds::closed(-kMaxAlongM, kMaxAlongM);
+// A time of an event inside a case, or a duration (see kMaxEventS).
+const Bounds kEventStartBounds = Bounds::closed(0, kMaxEventS);
+const Bounds kEventLengthBounds = Bounds::open_closed(0, kMaxEventS);
+// Dropout and degraded lists: a real log has a handful; this bounds the work.
+constexpr std::size_t kMaxEpisodes = 1000;
 
 FieldSpec read_field(const YamlSection& section) {
     FieldSpec field;
     const YamlSection origin = section.required_section("origin");
+    // Transverse Mercator field frame: not near the poles.
     field.origin.lat_deg = origin.required_in_range<double>("lat_deg", Bounds::closed(-85, 85));
     field.origin.lon_deg = origin.required_in_range<double>("lon_deg", Bounds::closed(-180, 180));
+    // Dead Sea shore (-430 m) to above the highest farmland (~5000 m), with margin.
     field.origin.height_m = origin.optional_in_range<double>("height_m", 0.0, Bounds::closed(-1000, 10000));
     field.heading_deg = section.required_in_range<double>("heading_deg", Bounds::closed_open(0, 360));
     return field;
@@ -133,15 +148,21 @@ VehicleSpec read_vehicle(const YamlSection& section, bool standing) {
     VehicleSpec vehicle;
     if (standing) {
         vehicle.speed_km_h = section.optional_in_range<double>("speed_km_h", 0.0, Bounds::closed(0, 30));
-        vehicle.start_m = section.optional<double>("start_m", 0.0);
+        vehicle.start_m = section.optional_in_range<double>("start_m", 0.0, kAlongBounds);
         return vehicle;
     }
-    vehicle.speed_km_h = section.required_in_range<double>("speed_km_h", Bounds::open_closed(0, 30));
-    vehicle.accel_m_s2 = section.optional_in_range<double>("accel_m_s2", vehicle.accel_m_s2, Bounds::open_closed(0, 5));
-    vehicle.start_m = section.required<double>("start_m");
-    vehicle.overrun_m = section.optional_in_range<double>("overrun_m", vehicle.overrun_m, Bounds::at_least(0));
+    // A boom sprayer works at 3-12 km/h; 30 is a road speed. Below 0.5 km/h
+    // the route would take days (10 km at 0.5 km/h is 20 h).
+    vehicle.speed_km_h = section.required_in_range<double>("speed_km_h", Bounds::closed(0.5, 30));
+    // A loaded tractor pulls away at ~0.5 m/s^2; 0.05 takes 33 s to 6 km/h, 5 is a sports car.
+    vehicle.accel_m_s2 =
+        section.optional_in_range<double>("accel_m_s2", vehicle.accel_m_s2, Bounds::closed(0.05, 5));
+    vehicle.start_m = section.required_in_range<double>("start_m", kAlongBounds);
+    // Past the breakpoint and before it: a headland-to-headland row is at most ~1 km.
+    vehicle.overrun_m = section.optional_in_range<double>("overrun_m", vehicle.overrun_m, Bounds::closed(0, 1000));
     vehicle.first_pass_m =
         section.optional_in_range<double>("first_pass_m", vehicle.first_pass_m, Bounds::open_closed(0, 1000));
+    // Ten minutes is far more than the valve reset (~2 x 11 s) needs.
     vehicle.wait_before_first_pass_s = section.optional_in_range<double>(
         "wait_before_first_pass_s", vehicle.wait_before_first_pass_s, Bounds::closed(0, 600));
     return vehicle;
@@ -149,25 +170,31 @@ VehicleSpec read_vehicle(const YamlSection& section, bool standing) {
 
 BoomSpec read_boom(const YamlSection& section) {
     BoomSpec boom;
-    boom.l1_m = section.optional_in_range<double>("l1_m", boom.l1_m, Bounds::at_least(0));
-    boom.l2_m = section.optional_in_range<double>("l2_m", boom.l2_m, Bounds::at_least(0));
-    boom.l3_m = section.optional_in_range<double>("l3_m", boom.l3_m, Bounds::at_least(0));
-    boom.linkage_rise_m = section.optional_in_range<double>("linkage_rise_m", boom.linkage_rise_m, Bounds::at_least(0));
+    // Antenna to nozzle line on a tractor and its boom: metres, not tens of metres.
+    // L2 divides h in Eq. 6 (atan(h/L2)), so it cannot be 0.
+    boom.l1_m = section.optional_in_range<double>("l1_m", boom.l1_m, Bounds::closed(0, 20));
+    boom.l2_m = section.optional_in_range<double>("l2_m", boom.l2_m, Bounds::open_closed(0, 20));
+    boom.l3_m = section.optional_in_range<double>("l3_m", boom.l3_m, Bounds::closed(0, 20));
+    // The three-point linkage lifts the boom by well under 2 m.
+    boom.linkage_rise_m =
+        section.optional_in_range<double>("linkage_rise_m", boom.linkage_rise_m, Bounds::closed(0, 5));
     return boom;
 }
 
 BreakpointSpec read_breakpoint(const YamlSection& section) {
     BreakpointSpec breakpoint;
-    breakpoint.along_m = section.optional<double>("along_m", breakpoint.along_m);
+    breakpoint.along_m = section.optional_in_range<double>("along_m", breakpoint.along_m, kAlongBounds);
+    // The operator presses the button seconds after stopping; ten minutes is generous.
     breakpoint.button_at_s =
-        section.optional_in_range<double>("button_at_s", breakpoint.button_at_s, Bounds::greater_than(0));
+        section.optional_in_range<double>("button_at_s", breakpoint.button_at_s, Bounds::open_closed(0, 600));
     return breakpoint;
 }
 
 GnssSpec read_gnss(const YamlSection& section) {
     GnssSpec gnss;
     gnss.talker = section.optional_enum<GnssTalker>("talker", kTalkers, gnss.talker);
-    gnss.rate_hz = section.optional_in_range<double>("rate_hz", gnss.rate_hz, Bounds::open_closed(0, 20));
+    // Receivers output 1-20 Hz (the G970II 5 Hz); the epoch period 1/rate is a timer.
+    gnss.rate_hz = section.optional_in_range<double>("rate_hz", gnss.rate_hz, Bounds::closed(1, 20));
     gnss.latency_s = section.optional_in_range<double>("latency_s", gnss.latency_s, Bounds::closed_open(0, 1));
     if (section.has("epoch_phase_s")) {
         gnss.epoch_phase_s = section.required_in_range<double>("epoch_phase_s", Bounds::closed_open(0, 1.0 / gnss.rate_hz));
@@ -175,27 +202,39 @@ GnssSpec read_gnss(const YamlSection& section) {
     gnss.fix = section.optional_enum<GnssFix>("fix", kFixes, gnss.fix);
 
     const YamlSection noise = section.section("noise");
-    gnss.noise.base_m = noise.optional_in_range<double>("base_m", gnss.noise.base_m, Bounds::at_least(0));
-    gnss.noise.ppm = noise.optional_in_range<double>("ppm", gnss.noise.ppm, Bounds::at_least(0));
-    gnss.noise.baseline_km = noise.optional_in_range<double>("baseline_km", gnss.noise.baseline_km, Bounds::at_least(0));
+    // Autonomous GPS is off by metres, RTK by 1-2 cm + 1 ppm; 100 m is a broken receiver.
+    gnss.noise.base_m = noise.optional_in_range<double>("base_m", gnss.noise.base_m, Bounds::closed(0, 100));
+    gnss.noise.ppm = noise.optional_in_range<double>("ppm", gnss.noise.ppm, Bounds::closed(0, 100));
+    // RTK corrections are usable to a few tens of km from the base.
+    gnss.noise.baseline_km =
+        noise.optional_in_range<double>("baseline_km", gnss.noise.baseline_km, Bounds::closed(0, 200));
 
-    for (const YamlSection& item : section.list("dropouts")) {
+    const std::vector<YamlSection> dropouts = section.list("dropouts");
+    if (dropouts.size() > kMaxEpisodes) section.fail("dropouts", "at most " + std::to_string(kMaxEpisodes) + " items");
+    for (const YamlSection& item : dropouts) {
         GnssDropout dropout;
         if (item.has("before_breakpoint_s")) {
             if (item.has("at_s")) item.fail("at_s", "give either at_s or before_breakpoint_s, not both");
-            dropout.before_breakpoint_s = item.required_in_range<double>("before_breakpoint_s", Bounds::at_least(0));
+            dropout.before_breakpoint_s = item.required_in_range<double>("before_breakpoint_s", kEventStartBounds);
+            dropout.at_location = item.location("before_breakpoint_s");
         } else {
-            dropout.at_s = item.required_in_range<double>("at_s", Bounds::at_least(0));
+            dropout.at_s = item.required_in_range<double>("at_s", kEventStartBounds);
+            dropout.at_location = item.location("at_s");
         }
-        dropout.for_s = item.required_in_range<double>("for_s", Bounds::greater_than(0));
+        dropout.for_s = item.required_in_range<double>("for_s", kEventLengthBounds);
+        dropout.for_location = item.location("for_s");
         gnss.dropouts.push_back(dropout);
     }
-    for (const YamlSection& item : section.list("degraded")) {
+    const std::vector<YamlSection> episodes = section.list("degraded");
+    if (episodes.size() > kMaxEpisodes) section.fail("degraded", "at most " + std::to_string(kMaxEpisodes) + " items");
+    for (const YamlSection& item : episodes) {
         GnssDegraded degraded;
-        degraded.at_s = item.required_in_range<double>("at_s", Bounds::at_least(0));
-        degraded.for_s = item.required_in_range<double>("for_s", Bounds::greater_than(0));
+        degraded.at_s = item.required_in_range<double>("at_s", kEventStartBounds);
+        degraded.at_location = item.location("at_s");
+        degraded.for_s = item.required_in_range<double>("for_s", kEventLengthBounds);
+        degraded.for_location = item.location("for_s");
         degraded.fix = item.optional_enum<GnssFix>("fix", kFixes, degraded.fix);
-        degraded.sigma_m = item.required_in_range<double>("sigma_m", Bounds::at_least(0));
+        degraded.sigma_m = item.required_in_range<double>("sigma_m", Bounds::closed(0, 100));
         gnss.degraded.push_back(degraded);
     }
     return gnss;
@@ -203,13 +242,17 @@ GnssSpec read_gnss(const YamlSection& section) {
 
 EncoderSpec read_encoder(const YamlSection& section) {
     EncoderSpec encoder;
-    encoder.pulses_per_rev =
-        section.optional_in_range<std::uint32_t>("pulses_per_rev", encoder.pulses_per_rev, Bounds::greater_than(0));
+    // Shaft encoders: 100-10000 p/r (the ZSP5208 1000); more would flood the counter.
+    encoder.pulses_per_rev = section.optional_in_range<std::uint32_t>("pulses_per_rev", encoder.pulses_per_rev,
+                                                                      Bounds::closed(1, 100'000));
+    // Land wheels are 0.3-1.5 m; a tractor's rear tyre up to ~2.2 m.
     encoder.wheel_diameter_m =
-        section.optional_in_range<double>("wheel_diameter_m", encoder.wheel_diameter_m, Bounds::greater_than(0));
-    encoder.rate_hz = section.optional_in_range<double>("rate_hz", encoder.rate_hz, Bounds::open_closed(0, 1000));
+        section.optional_in_range<double>("wheel_diameter_m", encoder.wheel_diameter_m, Bounds::closed(0.1, 3));
+    // Publication period 1/rate is a timer: at least 1 Hz.
+    encoder.rate_hz = section.optional_in_range<double>("rate_hz", encoder.rate_hz, Bounds::closed(1, 1000));
     encoder.slip_pct = section.optional_in_range<double>("slip_pct", encoder.slip_pct, Bounds::closed(-20, 20));
-    encoder.slip_sd_pct = section.optional_in_range<double>("slip_sd_pct", encoder.slip_sd_pct, Bounds::at_least(0));
+    // A spread as large as half the slip range.
+    encoder.slip_sd_pct = section.optional_in_range<double>("slip_sd_pct", encoder.slip_sd_pct, Bounds::closed(0, 10));
     encoder.deflection_pct =
         section.optional_in_range<double>("deflection_pct", encoder.deflection_pct, Bounds::closed_open(0, 20));
     encoder.terrain_sd_m_per_sqrt_m = section.optional_in_range<double>(
@@ -219,15 +262,19 @@ EncoderSpec read_encoder(const YamlSection& section) {
 
 HydraulicsSpec read_hydraulics(const YamlSection& section) {
     HydraulicsSpec h;
+    // Boom-sprayer pumps: tens to ~200 L/min.
     h.pump_flow_l_min = section.optional_in_range<double>("pump_flow_l_min", h.pump_flow_l_min, Bounds::open_closed(0, 200));
     h.pump_pulsation_pct =
         section.optional_in_range<double>("pump_pulsation_pct", h.pump_pulsation_pct, Bounds::closed(0, 50));
+    // Plunger strokes: ~500 rpm x 3 plungers = 27 Hz; 1-500 Hz covers any pump.
     h.pump_pulsation_hz =
-        section.optional_in_range<double>("pump_pulsation_hz", h.pump_pulsation_hz, Bounds::open_closed(0, 500));
-    h.pipeline_time_constant_s = section.optional_in_range<double>("pipeline_time_constant_s",
-                                                                   h.pipeline_time_constant_s, Bounds::open_closed(0, 10));
+        section.optional_in_range<double>("pump_pulsation_hz", h.pump_pulsation_hz, Bounds::closed(1, 500));
+    // A hose fills in tenths of a second; 10 ms is a pipe with no volume.
+    h.pipeline_time_constant_s = section.optional_in_range<double>(
+        "pipeline_time_constant_s", h.pipeline_time_constant_s, Bounds::closed(0.01, 10));
     const YamlSection valve = section.section("valve");
-    h.valve_travel_s = valve.optional_in_range<double>("travel_s", h.valve_travel_s, Bounds::open_closed(0, 120));
+    // Motorised ball valves turn in 2-30 s (the paper's 11 s); 0.1 s is a solenoid.
+    h.valve_travel_s = valve.optional_in_range<double>("travel_s", h.valve_travel_s, Bounds::closed(0.1, 120));
     h.valve_backlash_pct = valve.optional_in_range<double>("backlash_pct", h.valve_backlash_pct, Bounds::closed(0, 20));
     h.valve_motor_start_delay_s =
         valve.optional_in_range<double>("motor_start_delay_s", h.valve_motor_start_delay_s, Bounds::closed(0, 1));
@@ -241,60 +288,69 @@ HydraulicsSpec read_hydraulics(const YamlSection& section) {
     if (section.has("section_nozzles")) {
         h.section_nozzles.clear();
         const std::vector<std::string> counts = section.string_list("section_nozzles");
+        // Checked before the items: a list of a million items is refused at once.
+        if (counts.empty() || counts.size() > 8) section.fail("section_nozzles", "must list 1 to 8 sections");
         for (std::size_t i = 0; i < counts.size(); ++i) {
             int nozzles = 0;
             const auto result = std::from_chars(counts[i].data(), counts[i].data() + counts[i].size(), nozzles);
             if (result.ec != std::errc{} || result.ptr != counts[i].data() + counts[i].size() || nozzles < 1 ||
                 nozzles > 64) {
+                std::string shown = counts[i].size() > 20 ? counts[i].substr(0, 20) + "..." : counts[i];
                 throw ConfigError(section.item_location("section_nozzles", i),
-                                  "a section's nozzle count must be a whole number in [1, 64], got '" + counts[i] + "'");
+                                  "a section's nozzle count must be a whole number in [1, 64], got '" + shown + "'");
             }
             h.section_nozzles.push_back(nozzles);
         }
-        if (h.section_nozzles.empty() || h.section_nozzles.size() > 8) {
-            section.fail("section_nozzles", "must list 1 to 8 sections");
-        }
     }
-    h.boom_width_m = section.optional_in_range<double>("boom_width_m", h.boom_width_m, Bounds::open_closed(0, 60));
+    // Booms are 12-36 m (the paper's 12.2 m); 60 m is the widest built.
+    h.boom_width_m = section.optional_in_range<double>("boom_width_m", h.boom_width_m, Bounds::closed(1, 60));
     h.section_valve_open_s =
         section.optional_in_range<double>("section_valve_open_s", h.section_valve_open_s, Bounds::closed(0, 5));
     h.section_valve_close_s =
         section.optional_in_range<double>("section_valve_close_s", h.section_valve_close_s, Bounds::closed(0, 5));
     h.droplet_fall_s = section.optional_in_range<double>("droplet_fall_s", h.droplet_fall_s, Bounds::closed(0, 2));
+    // Flat-fan nozzles pass 0.2-5 L/min; a nozzle that passes 10 mL/min is shut.
     h.min_nozzle_flow_l_min =
-        section.optional_in_range<double>("min_nozzle_flow_l_min", h.min_nozzle_flow_l_min, Bounds::open_closed(0, 20));
+        section.optional_in_range<double>("min_nozzle_flow_l_min", h.min_nozzle_flow_l_min, Bounds::closed(0.01, 20));
     return h;
 }
 
 FlowMeterSpec read_flow_meter(const YamlSection& section) {
     FlowMeterSpec meter;
-    meter.pulses_per_l = section.optional_in_range<double>("pulses_per_l", meter.pulses_per_l, Bounds::open_closed(0, 1e5));
+    // Turbine meters give 1-10000 pulses per litre (the KF11 90); the pulse period is a timer.
+    meter.pulses_per_l = section.optional_in_range<double>("pulses_per_l", meter.pulses_per_l, Bounds::closed(1, 1e4));
     meter.k_factor_error_pct =
         section.optional_in_range<double>("k_factor_error_pct", meter.k_factor_error_pct, Bounds::closed(-50, 50));
-    meter.rate_hz = section.optional_in_range<double>("rate_hz", meter.rate_hz, Bounds::open_closed(0, 1000));
+    meter.rate_hz = section.optional_in_range<double>("rate_hz", meter.rate_hz, Bounds::closed(1, 1000));
     return meter;
 }
 
 PumpSensorSpec read_pump_sensor(const YamlSection& section) {
     PumpSensorSpec sensor;
+    // Turbine flow sensors span 0.1-1000 m^3/h (the WL-LWGA-20 8).
     sensor.full_scale_m3_h =
-        section.optional_in_range<double>("full_scale_m3_h", sensor.full_scale_m3_h, Bounds::open_closed(0, 1000));
+        section.optional_in_range<double>("full_scale_m3_h", sensor.full_scale_m3_h, Bounds::closed(0.1, 1000));
+    // On a 3.3 V span; 1 V of noise is a broken wire.
     sensor.noise_mv = section.optional_in_range<double>("noise_mv", sensor.noise_mv, Bounds::closed(0, 1000));
+    // A 4-20 mA loop: the zero can move by at most the loop's own range.
     sensor.offset_ma = section.optional_in_range<double>("offset_ma", sensor.offset_ma, Bounds::closed(-4, 16));
-    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::open_closed(0, 1000));
+    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::closed(1, 1000));
     return sensor;
 }
 
 BoomHeightSensorSpec read_boom_height_sensor(const YamlSection& section) {
     BoomHeightSensorSpec sensor;
-    sensor.range_m = section.optional_in_range<double>("range_m", sensor.range_m, Bounds::open_closed(0, 10));
-    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::open_closed(0, 1000));
+    // Pull-wire sensors reach 0.1-10 m.
+    sensor.range_m = section.optional_in_range<double>("range_m", sensor.range_m, Bounds::closed(0.1, 10));
+    sensor.rate_hz = section.optional_in_range<double>("rate_hz", sensor.rate_hz, Bounds::closed(1, 1000));
     return sensor;
 }
 
 DepositionSpec read_deposition(const YamlSection& section) {
     DepositionSpec deposition;
+    // Grid cells of 5 mm to 1 m; with kMaxAlongM that bounds the grid to a few million cells.
     deposition.cell_m = section.optional_in_range<double>("cell_m", deposition.cell_m, Bounds::closed(0.005, 1));
+    // A flat fan's band along the track: 1 cm to 2 m.
     deposition.footprint_m =
         section.optional_in_range<double>("footprint_m", deposition.footprint_m, Bounds::closed(0.01, 2));
     deposition.sprayed_fraction =
@@ -309,29 +365,38 @@ DepositionSpec read_deposition(const YamlSection& section) {
     return deposition;
 }
 
+// A device path or "pty"; PATH_MAX-style limits are far above any real port name.
+std::string read_port(const YamlSection& section, std::string_view key, const std::string& fallback) {
+    std::string port = section.optional<std::string>(key, fallback);
+    if (port.empty()) section.fail(key, "must be 'pty' or a serial device path");
+    if (port.size() > 255) section.fail(key, "is " + std::to_string(port.size()) + " characters long, at most 255");
+    return port;
+}
+
 WiringSpec read_wiring(const YamlSection& section) {
     WiringSpec wiring;
     wiring.gnss = section.optional_enum<GnssWire>("gnss", kGnssWires, wiring.gnss);
     wiring.board_io = section.optional_enum<BoardIoWireKind>("board_io", kBoardIoWires, wiring.board_io);
-    wiring.gnss_port = section.optional<std::string>("gnss_port", wiring.gnss_port);
+    wiring.gnss_port = read_port(section, "gnss_port", wiring.gnss_port);
+    // Serial lines: 1200 baud to 4 Mbaud (the fastest USB-serial adapters).
     wiring.nmea_baud = section.optional_in_range<int>("nmea_baud", wiring.nmea_baud, Bounds::closed(1200, 4000000));
-    wiring.modbus_port = section.optional<std::string>("modbus_port", wiring.modbus_port);
+    wiring.modbus_port = read_port(section, "modbus_port", wiring.modbus_port);
     wiring.modbus_baud = section.optional_in_range<int>("modbus_baud", wiring.modbus_baud, Bounds::closed(1200, 4000000));
-    wiring.modbus_tcp = section.optional<std::string>("modbus_tcp", wiring.modbus_tcp);
+    wiring.modbus_tcp = read_port(section, "modbus_tcp", wiring.modbus_tcp);
     wiring.hid_vid = static_cast<std::uint16_t>(
         section.optional_in_range<std::uint32_t>("hid_vid", wiring.hid_vid, Bounds::closed(0, 0xFFFF)));
     wiring.hid_pid = static_cast<std::uint16_t>(
         section.optional_in_range<std::uint32_t>("hid_pid", wiring.hid_pid, Bounds::closed(0, 0xFFFF)));
+    // The board's input refresh: a timer, 1 Hz to 2 kHz.
     wiring.board_update_hz =
         section.optional_in_range<double>("board_update_hz", wiring.board_update_hz, Bounds::closed(1, 2000));
     wiring.external_controller = section.optional_enum<bool>("controller", kControllerPlaces, wiring.external_controller);
-    if (wiring.gnss_port.empty()) section.fail("gnss_port", "must be 'pty' or a serial device path");
-    if (wiring.modbus_port.empty()) section.fail("modbus_port", "must be 'pty' or a serial device path");
     return wiring;
 }
 
 StaticFlowSpec read_static_flow(const YamlSection& section) {
     StaticFlowSpec static_flow;
+    // A static test lasts minutes (Table 2's adjust times are seconds); an hour each at most.
     static_flow.spray_on_at_s =
         section.optional_in_range<double>("spray_on_at_s", static_flow.spray_on_at_s, Bounds::closed(0, 3600));
     static_flow.spray_for_s =
@@ -354,8 +419,16 @@ ControllerSpec read_controller(const YamlSection& root) {
         if (controller.command.empty()) {
             section.fail("command", "must name the controller executable, e.g. [ \"rig-controller\" ]");
         }
+        // An argv, not a data channel: bounded like a shell command line.
+        if (controller.command.size() > 64) section.fail("command", "at most 64 arguments");
+        for (std::size_t i = 0; i < controller.command.size(); ++i) {
+            if (controller.command[i].size() > 4096) {
+                throw ConfigError(section.item_location("command", i), "an argument of at most 4096 characters");
+            }
+        }
     }
-    // The harness judges flow against the target the controller is given.
+    // The harness judges flow against the target the controller is given
+    // (boom-sprayer pumps deliver at most ~200 L/min; see hydraulics).
     if (section.has("target_flow_l_min")) {
         controller.target_flow_l_min =
             section.required_in_range<double>("target_flow_l_min", Bounds::open_closed(0, 250));
@@ -366,10 +439,17 @@ ControllerSpec read_controller(const YamlSection& root) {
 std::map<std::string, double> read_limits(const YamlSection& section) {
     std::map<std::string, double> limits;
     for (const std::string& name : section.keys()) {
+        // Metric names are a few words; the name is repeated in every message.
+        if (name.size() > 64) {
+            throw ConfigError(section.key_location(name), "metric name of " + std::to_string(name.size()) +
+                                                              " characters, at most 64");
+        }
         if (const std::string problem = metric_name_problem(name); !problem.empty()) {
             throw ConfigError(section.key_location(name), problem);
         }
-        limits[name] = section.required<double>(name);
+        // Limits are on metres, seconds, percent and counts of one case; no
+        // metric the harness measures comes near a million of any of them.
+        limits[name] = section.required_in_range<double>(name, Bounds::closed(-1e6, 1e6));
     }
     return limits;
 }
@@ -392,6 +472,7 @@ ExpectSpec read_expect(const YamlSection& section) {
 
 TimeoutsSpec read_timeouts(const YamlSection& section) {
     TimeoutsSpec timeouts;
+    // Wall time: a node acks a tick in milliseconds; a case runs minutes, a day at most.
     timeouts.node_ack_s =
         section.optional_in_range<double>("node_ack_s", timeouts.node_ack_s, Bounds::open_closed(0, 600));
     timeouts.case_wall_s =
@@ -416,6 +497,18 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                                                 " m strip to judge (vehicle.first_pass_m + vehicle.overrun_m)");
         }
     }
+    if (spec.scenario != Scenario::static_flow) {
+        // The land wheel's terrain (odometer truth) is drawn for this much ground.
+        const double terrain_m = emulators::LandWheelParams{}.terrain_length_m;
+        const double driven_m =
+            spec.vehicle.first_pass_m + (spec.breakpoint.along_m - spec.vehicle.start_m) + spec.vehicle.overrun_m;
+        if (driven_m > terrain_m) {
+            root.section("vehicle").fail("start_m", "the route drives " + number_text(driven_m) +
+                                                        " m (first_pass_m + breakpoint.along_m - start_m + "
+                                                        "overrun_m); at most " +
+                                                        number_text(terrain_m) + " m of ground is modelled");
+        }
+    }
     if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
         root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
     }
@@ -432,15 +525,16 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     const YamlSection expect = root.section("expect");
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
         const std::string& metric = spec.expect.fail[index];
+        const std::string shown = metric.size() > 64 ? metric.substr(0, 64) + "..." : metric;
         if (!spec.limits.contains(metric) &&
             !(default_limits.contains(metric) && default_limit_applies(spec.scenario, metric))) {
             throw ConfigError(expect.item_location("fail", index),
-                              "'" + metric + "' has no limit; expected failures must name limited metrics "
+                              "'" + shown + "' has no limit; expected failures must name limited metrics "
                               "(limits in this file or the defaults)");
         }
         for (std::size_t earlier = 0; earlier < index; ++earlier) {
             if (spec.expect.fail[earlier] == metric) {
-                throw ConfigError(expect.item_location("fail", index), "'" + metric + "' is listed twice");
+                throw ConfigError(expect.item_location("fail", index), "'" + shown + "' is listed twice");
             }
         }
     }
@@ -509,10 +603,20 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.source_path = source_path;
 
     spec.name = root.required<std::string>("name");
-    if (root.has("name") && !is_case_name(spec.name)) {
-        root.fail("name", "must be letters, digits, '.', '_' or '-' (it names output files), got '" + spec.name + "'");
+    spec.name_location = root.location("name");
+    if (root.has("name")) {
+        // The name is a directory under --out: `..` would be --out itself (and
+        // its removal would delete what was there), `.` would be cases/.
+        if (const std::string problem = plain_file_name_problem(spec.name, kMaxCaseNameLength); !problem.empty()) {
+            const std::string shown = spec.name.size() > 40 ? spec.name.substr(0, 40) + "..." : spec.name;
+            root.fail("name", "case name " + problem + ", got '" + shown + "'");
+        }
     }
     spec.description = root.optional<std::string>("description", "");
+    if (spec.description.size() > kMaxDescriptionLength) {
+        root.fail("description", "is " + std::to_string(spec.description.size()) + " characters long, at most " +
+                                     std::to_string(kMaxDescriptionLength));
+    }
     spec.seed = root.optional<std::uint64_t>("seed", spec.seed);
     if (root.has("seeds")) {
         if (root.has("seed")) root.fail("seeds", "give either `seed` or `seeds`, not both");
@@ -537,8 +641,10 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);
     const auto utc_start = parse_utc(spec.utc_start_iso);
     if (!utc_start) {
-        root.fail("utc_start", "expected an ISO-8601 UTC time like 2023-07-15T02:00:00Z, got '" +
-                                   spec.utc_start_iso + "'");
+        const std::string shown =
+            spec.utc_start_iso.size() > 40 ? spec.utc_start_iso.substr(0, 40) + "..." : spec.utc_start_iso;
+        root.fail("utc_start", "expected an ISO-8601 UTC time from 1980 to 2099 like 2023-07-15T02:00:00Z, got '" +
+                                   shown + "'");
     }
     spec.utc_start = *utc_start;
 
@@ -576,12 +682,78 @@ CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& fil
 }
 
 CaseSpec load_case_file(const std::filesystem::path& path, const std::map<std::string, double>& default_limits) {
-    CaseSpec spec = read_case(YamlSection::load_file(path), path, default_limits);
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    spec.source_text = text.str();
+    // Read once, by type and bounded (rig/file_access.h), then parsed from memory;
+    // the text is kept for the trace.
+    std::string text;
+    try {
+        text = read_regular_file(path, OpenOptions{.no_follow = false, .max_bytes = kMaxConfigFileBytes,
+                                                   .what = "case file"});
+    } catch (const FileAccessError& error) {
+        throw ConfigError(SourceLocation{path.string(), 0, 0, "(file)"}, error.problem());
+    }
+    CaseSpec spec = read_case(YamlSection::load_string(text, path.string()), path, default_limits);
+    spec.source_text = text;
     return spec;
+}
+
+namespace {
+
+std::string location_text(const SourceLocation& where) {
+    std::string text = where.file;
+    if (where.line > 0) text += ":" + std::to_string(where.line) + ":" + std::to_string(where.column);
+    return text;
+}
+
+}  // namespace
+
+std::vector<std::string> duplicate_case_name_errors(const std::vector<CaseSpec>& specs) {
+    std::vector<std::string> errors;
+    std::unordered_map<std::string, std::size_t> first_with_name;
+    for (std::size_t index = 0; index < specs.size(); ++index) {
+        const auto [first, inserted] = first_with_name.emplace(specs[index].name, index);
+        if (inserted) continue;
+        const CaseSpec& earlier = specs[first->second];
+        errors.push_back(ConfigError(specs[index].name_location,
+                                     "case name '" + specs[index].name + "' is also the name of " +
+                                         location_text(earlier.name_location) +
+                                         "; one run writes each case to cases/NAME/ under --out, so the two "
+                                         "would share a trace and a controller state: rename one")
+                             .what());
+    }
+    return errors;
+}
+
+void check_case_timeline(const CaseSpec& spec, double case_end_s, double breakpoint_crossing_s) {
+    const std::string length = number_text(case_end_s) + " s";
+    const auto check = [&](double at_s, double for_s, const SourceLocation& at_where,
+                           const SourceLocation& for_where, const char* what) {
+        if (at_s < 0.0) {
+            throw ConfigError(at_where, std::string(what) + " would start " + number_text(-at_s) +
+                                            " s before the case does (at " + number_text(at_s) + " s)");
+        }
+        if (at_s >= case_end_s) {
+            throw ConfigError(at_where, std::string(what) + " starts at " + number_text(at_s) +
+                                            " s, after the case ends (" + length + ")");
+        }
+        if (for_s > case_end_s) {
+            throw ConfigError(for_where, std::string(what) + " lasts " + number_text(for_s) +
+                                             " s, longer than the whole case (" + length + ")");
+        }
+    };
+    for (const GnssDropout& dropout : spec.gnss.dropouts) {
+        double at_s = dropout.at_s;
+        if (dropout.before_breakpoint_s) {
+            if (!std::isfinite(breakpoint_crossing_s)) {
+                throw ConfigError(dropout.at_location,
+                                  "a static test never crosses the breakpoint: give the dropout's at_s");
+            }
+            at_s = breakpoint_crossing_s - *dropout.before_breakpoint_s;
+        }
+        check(at_s, dropout.for_s, dropout.at_location, dropout.for_location, "the dropout");
+    }
+    for (const GnssDegraded& degraded : spec.gnss.degraded) {
+        check(degraded.at_s, degraded.for_s, degraded.at_location, degraded.for_location, "the degraded episode");
+    }
 }
 
 std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args) {

@@ -49,7 +49,7 @@ std::string_view to_string(GnssFix fix);
 struct GeoOrigin {
     double lat_deg = 0.0;  // required, [-85, 85]
     double lon_deg = 0.0;  // required, [-180, 180]
-    double height_m = 0.0;
+    double height_m = 0.0;  // [-1000, 10000]
 };
 
 struct FieldSpec {
@@ -58,17 +58,26 @@ struct FieldSpec {
 };
 
 struct VehicleSpec {
-    double speed_km_h = 0.0;  // required cruise speed, (0, 30]
-    double accel_m_s2 = 0.5;  // (0, 5]
-    double start_m = 0.0;     // required: nozzle line along the A-B line at approach start, < breakpoint.along_m
-    double overrun_m = 5.0;   // driven past the breakpoint before the case ends, >= 0
+    double speed_km_h = 0.0;  // required cruise speed, [0.5, 30] (a static test: [0, 30], unused)
+    double accel_m_s2 = 0.5;  // [0.05, 5]
+    // required: nozzle line along the A-B line at approach start, < breakpoint.along_m, |x| <= kMaxAlongM
+    double start_m = 0.0;
+    double overrun_m = 5.0;   // driven past the breakpoint before the case ends, [0, 1000]
     // The first pass ends with the nozzle line at the breakpoint; it starts this far before it.
-    double first_pass_m = 10.0;          // > 0
-    // Standing still before the first pass (time for the controller's valve reset), >= 0.
+    double first_pass_m = 10.0;          // (0, 1000]
+    // Standing still before the first pass (time for the controller's valve reset), [0, 600].
     double wait_before_first_pass_s = 0.0;
 };
+// Positions along the A-B line stay within this of the field origin: no field
+// row is 10 km long, and with the speed at least 0.5 km/h the longest route
+// (first pass, approach and overrun) lasts well under a day of simulated time.
+inline constexpr double kMaxAlongM = 10'000.0;
+// Times of events in a case (dropouts, episodes) are at most this; the
+// timeline check (check_case_timeline) then holds them to the case's length.
+inline constexpr double kMaxEventS = 86'400.0;
 
 // Antenna-to-nozzle geometry of Eq. 6: L4 = L1 + cos(atan(h/L2))*L2 + L3, 1.63 m with these values.
+// Each length [0, 20] m (l2_m (0, 20]: h/L2), linkage rise [0, 5] m.
 struct BoomSpec {
     double l1_m = 0.50;
     double l2_m = 0.80;
@@ -77,38 +86,43 @@ struct BoomSpec {
 };
 
 struct BreakpointSpec {
-    double along_m = 0.0;      // ground position of the breakpoint on the A-B line
-    double button_at_s = 1.0;  // vehicle stands with the nozzle line at along_m; button pressed then, > 0
+    double along_m = 0.0;      // ground position of the breakpoint on the A-B line, |x| <= kMaxAlongM
+    double button_at_s = 1.0;  // vehicle stands with the nozzle line at along_m; button pressed then, (0, 600]
 };
 
 struct GnssNoiseSpec {
-    double base_m = 0.008;  // RTK 8 mm + 1 ppm (paper)
-    double ppm = 1.0;
-    double baseline_km = 2.0;
+    double base_m = 0.008;  // RTK 8 mm + 1 ppm (paper); [0, 100]
+    double ppm = 1.0;       // [0, 100]
+    double baseline_km = 2.0;  // [0, 200]
     // 1-sigma horizontal error: base + ppm * baseline.
     double horizontal_sigma_m() const { return base_m + ppm * 1e-6 * baseline_km * 1000.0; }
 };
 
 // No sentences at all during [at_s, at_s + for_s).
 struct GnssDropout {
-    double at_s = 0.0;   // >= 0
+    double at_s = 0.0;   // [0, kMaxEventS]
     // Instead of at_s: start this long before the nozzle line reaches the
     // breakpoint on the approach (how Table 4 run 8's loss is placed).
     std::optional<double> before_breakpoint_s;
-    double for_s = 0.0;  // > 0
+    double for_s = 0.0;  // (0, kMaxEventS]
+    // Where the start (at_s or before_breakpoint_s) and for_s are written, for check_case_timeline.
+    SourceLocation at_location;
+    SourceLocation for_location;
 };
 
 // A worse fix during [at_s, at_s + for_s).
 struct GnssDegraded {
-    double at_s = 0.0;                    // >= 0
-    double for_s = 0.0;                   // > 0
+    double at_s = 0.0;                    // [0, kMaxEventS]
+    double for_s = 0.0;                   // (0, kMaxEventS]
     GnssFix fix = GnssFix::rtk_float;
-    double sigma_m = 0.0;                 // required, >= 0: 1-sigma horizontal error while degraded
+    double sigma_m = 0.0;                 // required, [0, 100]: 1-sigma horizontal error while degraded
+    SourceLocation at_location;
+    SourceLocation for_location;
 };
 
 struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
-    double rate_hz = 5.0;      // (0, 20]; the G970II runs at 5 Hz
+    double rate_hz = 5.0;      // [1, 20]; the G970II runs at 5 Hz
     double latency_s = 0.02;   // [0, 1): fix epoch -> the epoch's last sentence complete at the controller
     // Receiver epochs fall at epoch_phase_s + k / rate_hz of simulated time. The
     // receiver's epoch grid has nothing to do with where the sprayer is, so when
@@ -117,21 +131,22 @@ struct GnssSpec {
     std::optional<double> epoch_phase_s;
     GnssFix fix = GnssFix::rtk_fixed;
     GnssNoiseSpec noise;
-    std::vector<GnssDropout> dropouts;  // may overlap each other; not checked
-    std::vector<GnssDegraded> degraded;
+    std::vector<GnssDropout> dropouts;  // may overlap each other; at most 1000
+    std::vector<GnssDegraded> degraded;  // at most 1000
 };
 
 struct EncoderSpec {
-    std::uint32_t pulses_per_rev = 1000;  // > 0; the paper's ZSP5208 has 1000 p/r
-    double wheel_diameter_m = 1.0;        // > 0 (not given in the paper)
-    double rate_hz = 100.0;               // count publication rate, (0, 1000]
+    std::uint32_t pulses_per_rev = 1000;  // [1, 100000]; the paper's ZSP5208 has 1000 p/r
+    double wheel_diameter_m = 1.0;        // [0.1, 3] (not given in the paper)
+    double rate_hz = 100.0;               // count publication rate, [1, 1000]
     double slip_pct = 0.0;                // mean wheel slip, [-20, 20]; ideal wheel unless the case says so
-    double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), >= 0
+    double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), [0, 10]
     double deflection_pct = 0.0;          // loaded tyre: rolling radius below nominal, [0, 20) (emulators/land_wheel.h)
     double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 
 // The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
+// Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
 struct HydraulicsSpec {
     double pump_flow_l_min = 31.1;           // (0, 200]
     double pump_pulsation_pct = 2.0;         // [0, 50]
@@ -151,6 +166,7 @@ struct HydraulicsSpec {
     double min_nozzle_flow_l_min = 0.64;
 };
 
+// Ranges of this and the sensors below: case_spec.cpp, with their reasons.
 struct FlowMeterSpec {
     double pulses_per_l = 90.0;              // KF11-P10, Eq. 3
     double k_factor_error_pct = 0.0;
@@ -199,7 +215,7 @@ enum class BoardIoWireKind { dds, modbus_rtu, modbus_tcp, hid };
 struct WiringSpec {
     GnssWire gnss = GnssWire::dds;
     BoardIoWireKind board_io = BoardIoWireKind::dds;
-    std::string gnss_port = "pty";      // serial: pty or /dev/tty...
+    std::string gnss_port = "pty";      // serial: pty or /dev/tty... (at most 255 characters)
     int nmea_baud = 115200;
     std::string modbus_port = "pty";    // modbus_rtu: pty or /dev/tty...
     int modbus_baud = 115200;
@@ -217,7 +233,7 @@ std::string_view to_string(BoardIoWireKind wire);
 
 struct ControllerSpec {
     // argv of the controller executable; empty = the reference controller.
-    std::vector<std::string> command;
+    std::vector<std::string> command;  // at most 64 arguments of at most 4096 characters
     // The whole `controller:` section as written, with its location, for the
     // controller to validate. It includes `command`, which belongs to the rig:
     // a controller checking its keys must allow it (kControllerRigKeys).
@@ -244,9 +260,16 @@ struct TimeoutsSpec {
     double case_wall_s = 600.0;  // wall time for the whole case, (0, 86400]
 };
 
+// Case names name a directory (cases/NAME/ under --out), so they are plain
+// file names: [A-Za-z0-9._-]+, not starting with '.', at most this long.
+inline constexpr std::size_t kMaxCaseNameLength = 100;
+// Free text, printed in reports.
+inline constexpr std::size_t kMaxDescriptionLength = 2000;
+
 struct CaseSpec {
     std::filesystem::path source_path;
-    std::string name;  // required, [A-Za-z0-9._-]+
+    std::string name;  // required, see kMaxCaseNameLength
+    SourceLocation name_location;  // where `name` is written (duplicate names are reported there)
     std::string description;
     std::uint64_t seed = 1;  // `rig run --seed` overrides
     // `seeds: [..]` instead of `seed`: the case runs once per seed, as NAME-seedN
@@ -272,7 +295,7 @@ struct CaseSpec {
     StaticFlowSpec static_flow;
     WiringSpec wiring;
     ControllerSpec controller;
-    // Limits as written in the file (metric name -> max allowed value); the
+    // Limits as written in the file (metric name -> max allowed value, |v| <= 1e6); the
     // harness judges against effective_limits(), i.e. these over the defaults.
     std::map<std::string, double> limits;
     ExpectSpec expect;
@@ -313,6 +336,20 @@ CaseSpec load_case_file(const std::filesystem::path& path,
 // The same from text in memory; `file_name` is what errors call it.
 CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name,
                     const std::map<std::string, double>& default_limits = kDefaultLimits);
+
+// Two cases of one run with one name would share cases/NAME/ (trace, log,
+// controller state): one line per later case whose name an earlier one has,
+//   FILE:LINE:COL: name: case name 'x' is also the name of EARLIER_FILE:LINE:COL; ...
+// Empty when the names are distinct.
+std::vector<std::string> duplicate_case_name_errors(const std::vector<CaseSpec>& specs);
+
+// Checks the case's timed events against its timeline, which only the route
+// built from the whole file gives (harness/case_runner.h build_case_world:
+// `case_end_s` = ns_to_seconds(end_ns), `breakpoint_crossing_s`, NaN in a static
+// test): a dropout or degraded episode that starts before 0 or at/after the
+// end, or lasts longer than the whole case, is a ConfigError at its key.
+// (An episode that starts inside and runs past the end is cut by the end.)
+void check_case_timeline(const CaseSpec& spec, double case_end_s, double breakpoint_crossing_s);
 
 // Command-line case arguments to files: a file stays as given; a directory
 // becomes the `*.yaml` / `*.yml` files anywhere below it (hidden files and

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include <fstream>
+#include <map>
 #include <iostream>
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
 #include "harness/case_runner.h"
+#include "harness/case_world.h"
 #include "harness/html_report.h"
 #include "harness/judge_command.h"
 #include "harness/results_writer.h"
@@ -44,8 +46,25 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
             try {
                 specs.push_back(load_case_file(path));
                 validate_for_run(specs.back(), options);
+                // Dropouts and episodes against the case's length, which only its route gives.
+                const CaseWorld world = build_case_world(specs.back(), specs.back().seed);
+                check_case_timeline(specs.back(), rig::ns_to_seconds(world.end_ns), world.breakpoint_crossing_s);
             } catch (const std::exception& error) {
                 errors.push_back(error.what());
+            }
+        }
+        // Two cases with one name would write the same cases/NAME/.
+        for (const std::string& error : duplicate_case_name_errors(specs)) errors.push_back(error);
+        // ... and so would a run of a `seeds:` case named like another case (NAME-seedN).
+        if (errors.empty()) {
+            std::map<std::string, std::size_t> runs_named;
+            for (const CaseInstance& run : expand_runs(specs, options)) {
+                const auto [earlier, inserted] = runs_named.emplace(run.name, run.spec_index);
+                if (!inserted) {
+                    errors.push_back(specs[run.spec_index].source_path.string() + ": its run '" + run.name +
+                                     "' has the name of a run of " + specs[earlier->second].source_path.string() +
+                                     "; both would write cases/" + run.name + "/: rename one");
+                }
             }
         }
         if (!errors.empty()) {
@@ -86,12 +105,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
 
 int nmea_decode_command(const std::string& input) {
     if (input == "-") return rig::nmea::decode_stream(std::cin, std::cout);
-    std::ifstream file(input, std::ios::binary);
-    if (!file) {
-        std::cerr << "rig nmea decode: cannot open " << input << "\n";
-        return 2;
-    }
-    return rig::nmea::decode_stream(file, std::cout);
+    return rig::nmea::decode_file(input, std::cout, std::cerr);
 }
 
 }  // namespace

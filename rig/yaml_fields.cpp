@@ -1,5 +1,10 @@
 #include "rig/yaml_fields.h"
 
+#include "rig/file_access.h"
+
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -11,6 +16,8 @@
 #include <sstream>
 #include <system_error>
 #include <tuple>
+#include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 namespace rig {
@@ -51,11 +58,23 @@ SourceLocation location_at(const std::string& file, const YAML::Mark& mark, std:
     return where;
 }
 
+// A key as messages show it: one line, at most kMaxQuotedKeyChars (a key can
+// be a multi-line scalar of any length; an error must stay one short line).
+constexpr std::size_t kMaxQuotedKeyChars = 64;
+std::string shown_key(std::string_view key) {
+    std::string text(key.substr(0, kMaxQuotedKeyChars));
+    for (char& c : text) {
+        if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    }
+    if (key.size() > kMaxQuotedKeyChars) text += "...";
+    return text;
+}
+
 std::string child_path(const std::string& parent, std::string_view key) {
-    if (parent.empty()) return std::string(key);
+    if (parent.empty()) return shown_key(key);
     std::string path = parent;
     path += '.';
-    path += key;
+    path += shown_key(key);
     return path;
 }
 
@@ -142,7 +161,9 @@ public:
 
 private:
     void check_mapping(const YAML::Node& mapping, const std::string& path) {
-        std::vector<std::pair<std::string, YAML::Mark>> seen;
+        // Hashed: a mapping of n keys is checked in O(n), not O(n^2) (a 10 MB
+        // file of keys took 82 s to reject with a list).
+        std::unordered_map<std::string, YAML::Mark> seen;
         for (auto it = mapping.begin(); it != mapping.end(); ++it) {
             // Copies: yaml-cpp's iterator `->` points into a temporary proxy.
             const YAML::Node key = it->first;
@@ -153,15 +174,13 @@ private:
             }
             const std::string& name = key.Scalar();
             const std::string key_path = child_path(path, name);
-            for (const auto& [earlier, earlier_mark] : seen) {
-                if (earlier == name) {
-                    throw ConfigError(location_at(file_, key.Mark(), key_path),
-                                      "duplicate key '" + name + "' (first at line " +
-                                          std::to_string(earlier_mark.line + 1) + ", column " +
-                                          std::to_string(earlier_mark.column + 1) + ")");
-                }
+            const auto [earlier, inserted] = seen.emplace(name, key.Mark());
+            if (!inserted) {
+                const YAML::Mark& earlier_mark = earlier->second;
+                throw ConfigError(location_at(file_, key.Mark(), key_path),
+                                  "duplicate key '" + shown_key(name) + "' (first at line " + std::to_string(earlier_mark.line + 1) +
+                                      ", column " + std::to_string(earlier_mark.column + 1) + ")");
             }
-            seen.emplace_back(name, key.Mark());
             check(value, key_path);
         }
     }
@@ -170,6 +189,58 @@ private:
     std::vector<YAML::Node> ancestors_;
     std::size_t visited_ = 0;
 };
+
+// Counts a text's documents without building them, for at most two.
+//
+// Not YAML::LoadAll: in yaml-cpp 0.7 (Debian 12) a ',' outside [ ] or { } at
+// the top level (",", "[1]\n,") makes each HandleNextDocument() return an
+// empty document without consuming the ','; LoadAll then loops forever,
+// allocating (found by tests/fuzz/case_file_fuzz). A document that starts
+// where the previous one did is that: reported as a syntax error there.
+class DocumentCounter : public YAML::EventHandler {
+public:
+    void OnDocumentStart(const YAML::Mark& mark) override { start = mark; }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+    void OnMapEnd() override {}
+    YAML::Mark start = YAML::Mark::null_mark();
+};
+
+struct DocumentCount {
+    int documents = 0;
+    YAML::Mark second_start = YAML::Mark::null_mark();
+};
+
+DocumentCount count_documents(const std::string& text, const std::string& file_name) {
+    std::istringstream in(text);
+    DocumentCount count;
+    try {
+        YAML::Parser parser(in);
+        DocumentCounter counter;
+        YAML::Mark previous = YAML::Mark::null_mark();
+        // Up to three, so a stuck ',' after a first document is told from a real second one.
+        while (count.documents < 3 && parser.HandleNextDocument(counter)) {
+            if (count.documents >= 1) {
+                if (counter.start.pos == previous.pos) {
+                    throw ConfigError(location_at(file_name, counter.start, ""),
+                                      "YAML syntax error: a ',' outside [ ] or { } (or another token that "
+                                      "starts no value)");
+                }
+                if (count.documents == 1) count.second_start = counter.start;
+            }
+            previous = counter.start;
+            ++count.documents;
+        }
+    } catch (const YAML::Exception& error) {
+        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
+    }
+    return count;
+}
 
 template <class T>
 constexpr std::string_view expected_kind() {
@@ -323,21 +394,30 @@ struct YamlSection::State {
     SourceLocation location;
     bool present = false;
     std::vector<Entry> entries;
-    std::vector<std::string> known_keys;
+    // entries by key (keys are unique: the tree checker refuses duplicates).
+    // Lookups are hashed so a section whose keys are data (limits) reads in
+    // linear time however many it has.
+    std::unordered_map<std::string, std::size_t> entry_index;
+    std::vector<std::string> known_keys;  // in the order asked, for suggestions
+    std::unordered_set<std::string> known_key_set;
     std::vector<std::pair<std::string, std::shared_ptr<State>>> sections;
     std::vector<std::pair<std::string, std::vector<std::shared_ptr<State>>>> lists;
     std::vector<PendingMissing> missing;
 
     const std::string& file() const { return document->file; }
 
+    bool is_known(const std::string& key) const { return known_key_set.contains(key); }
+
+    const Entry* find(std::string_view key) const {
+        const auto it = entry_index.find(std::string(key));
+        return it == entry_index.end() ? nullptr : &entries[it->second];
+    }
+
+    // Finds `key` and marks it as known.
     const Entry* lookup(std::string_view key) {
-        if (std::find(known_keys.begin(), known_keys.end(), key) == known_keys.end()) {
-            known_keys.emplace_back(key);
-        }
-        for (const Entry& entry : entries) {
-            if (entry.key == key) return &entry;
-        }
-        return nullptr;
+        std::string name(key);
+        if (known_key_set.insert(name).second) known_keys.push_back(std::move(name));
+        return find(key);
     }
 
     SourceLocation key_location(const Entry& entry) const {
@@ -385,6 +465,7 @@ StatePtr make_state(std::shared_ptr<Document> document, std::string path, const 
     state->present = present;
     if (node.IsDefined() && node.IsMap()) {
         for (auto it = node.begin(); it != node.end(); ++it) {
+            state->entry_index.emplace(it->first.Scalar(), state->entries.size());
             state->entries.push_back(Entry{it->first.Scalar(), it->first, it->second});
         }
     }
@@ -451,27 +532,39 @@ T convert_scalar(const YamlSection::State& state, const Entry& entry, bool has_d
     }
 }
 
-void collect_unknown_keys(const YamlSection::State& state, std::vector<ConfigError>& unknown) {
+struct UnknownKey {
+    const YamlSection::State* state;
+    const Entry* entry;
+    SourceLocation where;
+};
+
+// Every key no accessor asked about; the message is made later for the one
+// reported (a suggestion costs an edit distance per known key, too much to
+// spend on each of thousands of unknown keys).
+void collect_unknown_keys(const YamlSection::State& state, std::vector<UnknownKey>& unknown) {
     for (const Entry& entry : state.entries) {
-        if (std::find(state.known_keys.begin(), state.known_keys.end(), entry.key) != state.known_keys.end()) {
-            continue;
-        }
-        std::string message = "unknown key '" + entry.key + "'";
-        if (state.known_keys.empty()) {
-            message += "; nothing is allowed here";
-        } else if (const auto suggestion = closest_spelling(entry.key, state.known_keys)) {
-            message += "; did you mean '" + *suggestion + "'?";
-        } else {
-            std::vector<std::string> sorted = state.known_keys;
-            std::sort(sorted.begin(), sorted.end());
-            message += "; known keys here: " + join(sorted, ", ");
-        }
-        unknown.emplace_back(state.key_location(entry), message);
+        if (!state.is_known(entry.key)) unknown.push_back({&state, &entry, state.key_location(entry)});
     }
     for (const auto& [key, child] : state.sections) collect_unknown_keys(*child, unknown);
     for (const auto& [key, items] : state.lists) {
         for (const StatePtr& item : items) collect_unknown_keys(*item, unknown);
     }
+}
+
+ConfigError unknown_key_error(const UnknownKey& unknown) {
+    const YamlSection::State& state = *unknown.state;
+    const std::string& key = unknown.entry->key;
+    std::string message = "unknown key '" + shown_key(key) + "'";
+    if (state.known_keys.empty()) {
+        message += "; nothing is allowed here";
+    } else if (const auto suggestion = closest_spelling(key, state.known_keys)) {
+        message += "; did you mean '" + *suggestion + "'?";
+    } else {
+        std::vector<std::string> sorted = state.known_keys;
+        std::sort(sorted.begin(), sorted.end());
+        message += "; known keys here: " + join(sorted, ", ");
+    }
+    return ConfigError(unknown.where, message);
 }
 
 void collect_missing(const YamlSection::State& state, std::vector<const PendingMissing*>& missing) {
@@ -507,21 +600,22 @@ YamlSection::YamlSection(const RawYaml& raw) : YamlSection(raw.node, raw.locatio
 }
 
 YamlSection YamlSection::load_string(std::string_view yaml_text, const std::string& file_name) {
-    std::vector<YAML::Node> documents;
-    try {
-        documents = YAML::LoadAll(std::string(yaml_text));
-    } catch (const YAML::Exception& error) {
-        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
-    }
-    if (documents.empty()) {
+    const std::string text(yaml_text);
+    const DocumentCount count = count_documents(text, file_name);
+    if (count.documents == 0) {
         throw ConfigError(SourceLocation{file_name, 1, 1, ""},
                           "the file is empty; expected a mapping of settings (key: value lines)");
     }
-    if (documents.size() > 1) {
-        throw ConfigError(location_at(file_name, documents[1].Mark(), ""),
+    if (count.documents > 1) {
+        throw ConfigError(location_at(file_name, count.second_start, ""),
                           "a second YAML document ('---') in the file; one file holds one document");
     }
-    const YAML::Node& root = documents.front();
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);  // the first document only: never LoadAll's loop
+    } catch (const YAML::Exception& error) {
+        throw ConfigError(location_at(file_name, error.mark, ""), "YAML syntax error: " + error.msg);
+    }
     if (!root.IsMap()) {
         throw ConfigError(location_at(file_name, root.IsNull() ? YAML::Mark{} : root.Mark(), ""),
                           "expected a mapping of settings (key: value lines) at the top level, got " +
@@ -533,20 +627,16 @@ YamlSection YamlSection::load_string(std::string_view yaml_text, const std::stri
 YamlSection YamlSection::load_file(const std::filesystem::path& path) {
     const std::string file_name = path.string();
     const SourceLocation whole_file{file_name, 0, 0, "(file)"};
-    std::error_code status_error;
-    const auto status = std::filesystem::status(path, status_error);
-    if (status.type() == std::filesystem::file_type::not_found) {
-        throw ConfigError(whole_file, "no such file");
+    std::string text;
+    try {
+        // Regular files only (a FIFO would block, a device never end) and of a
+        // bounded size (see kMaxConfigFileBytes).
+        text = read_regular_file(path, OpenOptions{.no_follow = false, .max_bytes = kMaxConfigFileBytes,
+                                                   .what = "YAML file"});
+    } catch (const FileAccessError& error) {
+        throw ConfigError(whole_file, error.problem());
     }
-    if (status.type() == std::filesystem::file_type::directory) {
-        throw ConfigError(whole_file, "is a directory, expected a YAML file");
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ConfigError(whole_file, std::string("cannot open: ") + std::strerror(errno));
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (in.bad()) throw ConfigError(whole_file, std::string("cannot read: ") + std::strerror(errno));
-    return load_string(text.str(), file_name);
+    return load_string(text, file_name);
 }
 
 const std::string& YamlSection::file() const { return state_->file(); }
@@ -555,24 +645,20 @@ bool YamlSection::present() const { return state_->present; }
 SourceLocation YamlSection::location() const { return state_->location; }
 
 SourceLocation YamlSection::location(std::string_view key) const {
-    for (const Entry& entry : state_->entries) {
-        if (entry.key == key) return state_->value_location(entry);
-    }
+    if (const Entry* entry = state_->find(key)) return state_->value_location(*entry);
     return state_->absent_location(key);
 }
 
 SourceLocation YamlSection::key_location(std::string_view key) const {
-    for (const Entry& entry : state_->entries) {
-        if (entry.key == key) return state_->key_location(entry);
-    }
+    if (const Entry* entry = state_->find(key)) return state_->key_location(*entry);
     return state_->absent_location(key);
 }
 
 SourceLocation YamlSection::item_location(std::string_view key, std::size_t index) const {
-    for (const Entry& entry : state_->entries) {
-        if (entry.key != key || !entry.value.IsSequence() || index >= entry.value.size()) continue;
-        const YAML::Node item = entry.value[index];
-        const YAML::Mark mark = item.IsNull() ? entry.value.Mark() : item.Mark();
+    const Entry* entry = state_->find(key);
+    if (entry != nullptr && entry->value.IsSequence() && index < entry->value.size()) {
+        const YAML::Node item = entry->value[index];
+        const YAML::Mark mark = item.IsNull() ? entry->value.Mark() : item.Mark();
         return location_at(file(), mark, item_path(child_path(state_->path, key), index));
     }
     return location(key);
@@ -785,13 +871,13 @@ void YamlSection::fail(std::string_view key, const std::string& message) const {
 void YamlSection::fail(const std::string& message) const { throw ConfigError(state_->location, message); }
 
 void YamlSection::finish() const {
-    std::vector<ConfigError> unknown;
+    std::vector<UnknownKey> unknown;
     collect_unknown_keys(*state_, unknown);
     if (!unknown.empty()) {
         const auto earliest = std::min_element(unknown.begin(), unknown.end(), [](const auto& a, const auto& b) {
-            return std::tie(a.where().line, a.where().column) < std::tie(b.where().line, b.where().column);
+            return std::tie(a.where.line, a.where.column) < std::tie(b.where.line, b.where.column);
         });
-        throw *earliest;
+        throw unknown_key_error(*earliest);
     }
     std::vector<const PendingMissing*> missing;
     collect_missing(*state_, missing);

@@ -39,6 +39,11 @@
 
 namespace rig {
 
+// Configuration files are a few kilobytes (the largest case in cases/ is
+// 2.3 KB); a megabyte is far beyond any, and bounds what parsing a wrong file
+// (a log, a core dump) given by mistake can cost.
+inline constexpr std::uint64_t kMaxConfigFileBytes = 1u << 20;
+
 // An allowed interval for a number, each end open, closed or unbounded.
 class Bounds {
 public:
