@@ -6,6 +6,8 @@
 #include <string>
 #include <utility>
 
+#include "emulators/seeded_random.h"
+
 namespace rig::emulators {
 namespace {
 
@@ -24,9 +26,16 @@ PwmNozzleValves::PwmNozzleValves(PwmValveParams params, field2d::NozzleFlowTable
         throw std::invalid_argument("pwm valves: response_s must be in [0, half a PWM period = " +
                                     std::to_string(0.5 * period_s_) + " s), got " + std::to_string(params_.response_s));
     }
-    if (!std::isfinite(params_.pwm_phase_s) || params_.pwm_phase_s < 0.0 || params_.pwm_phase_s >= period_s_) {
-        throw std::invalid_argument("pwm valves: pwm_phase_s must be in [0, one period = " + std::to_string(period_s_) +
-                                    " s), got " + std::to_string(params_.pwm_phase_s));
+    if (params_.pwm_phase_s) {
+        const double phase = *params_.pwm_phase_s;
+        if (!std::isfinite(phase) || phase < 0.0 || phase >= period_s_) {
+            throw std::invalid_argument("pwm valves: pwm_phase_s must be in [0, one period = " +
+                                        std::to_string(period_s_) + " s), got " + std::to_string(phase));
+        }
+        phase_s_ = phase;
+    } else {
+        SeededRandom draw(params_.seed, "pwm_valves.phase");
+        phase_s_ = draw.uniform01() * period_s_;
     }
     for (int n = 0; n < table_.nozzle_count(); ++n) {
         if (table_.max_duty_pct(n) != 100.0) {
@@ -37,7 +46,7 @@ PwmNozzleValves::PwmNozzleValves(PwmValveParams params, field2d::NozzleFlowTable
     valves_.resize(static_cast<std::size_t>(table_.nozzle_count()));
     // One period before the one that contains t = 0, so that the first
     // integration latches the duty of that period (commands at t = 0 included).
-    const std::int64_t first = params_.pwm_phase_s > 0.0 ? -1 : 0;
+    const std::int64_t first = phase_s_ > 0.0 ? -1 : 0;
     for (std::size_t n = 0; n < valves_.size(); ++n) {
         valves_[n].period = first - 1;
         valves_[n].flow_scale_ml_min = open_flow_ml_min(static_cast<int>(n), 100.0);

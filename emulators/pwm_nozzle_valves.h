@@ -5,7 +5,10 @@
 // needs from them: how much each nozzle delivers, pulse by pulse.
 //
 // Model, per nozzle:
-//   - PWM periods start at pwm_phase_s + k / frequency_hz. In a period with duty
+//   - PWM periods start at phase + k / frequency_hz (the phase of the
+//     controller's PWM against the run's clock: given, or drawn from the seed,
+//     stream "pwm_valves.phase", so where a switch-off falls between PWM edges
+//     varies run to run as on a real machine). In a period with duty
 //     d the drive is on for the first d / frequency_hz seconds, off for the rest
 //     (d = 0: always off, d = 100 %: always on).
 //   - A duty command takes effect at the start of the next period (as a PWM
@@ -27,6 +30,7 @@
 // period starts and (unlatched) command times.
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "emulators/field2d/nozzle_flow_table.h"
@@ -37,8 +41,9 @@ namespace rig::emulators {
 struct PwmValveParams {
     double frequency_hz = 9.0;          // (0, 1000]; Sec. 3.2.1
     double response_s = 0.015;          // [0, half a period); Table 1: 10-20 ms
-    double pwm_phase_s = 0.0;           // [0, period); assumed 0 (periods start at t = 0)
+    std::optional<double> pwm_phase_s;  // [0, period); unset: drawn from the seed
     bool latch_at_period_start = true;  // assumed, see above
+    std::uint64_t seed = 1;
 };
 
 class PwmNozzleValves {
@@ -71,6 +76,7 @@ public:
     double mean_flow_ml_min(int nozzle, double duty_pct) const;
 
     double period_s() const { return period_s_; }
+    double pwm_phase_s() const { return phase_s_; }
     const PwmValveParams& params() const { return params_; }
     const field2d::NozzleFlowTable& table() const { return table_; }
 
@@ -90,7 +96,7 @@ private:
     };
     // Open fraction integrated over one steady period of duty d (seconds).
     double open_time_per_period_s(double duty_pct) const;
-    double period_start_s(std::int64_t k) const { return params_.pwm_phase_s + static_cast<double>(k) * period_s_; }
+    double period_start_s(std::int64_t k) const { return phase_s_ + static_cast<double>(k) * period_s_; }
     // Integrates one valve over [from_s, to_s); returns litres.
     double integrate(Valve& valve, int nozzle, double from_s, double to_s) const;
     const Valve& valve(int nozzle) const;
@@ -98,6 +104,7 @@ private:
     PwmValveParams params_;
     field2d::NozzleFlowTable table_;
     double period_s_ = 0.0;
+    double phase_s_ = 0.0;
     TimeNs now_ns_ = 0;
     std::vector<Valve> valves_;
 };

@@ -22,6 +22,7 @@ PwmNozzleValves paper_valves(bool latched = true, double response_s = 0.015) {
     PwmValveParams p;
     p.latch_at_period_start = latched;
     p.response_s = response_s;
+    p.pwm_phase_s = 0.0;  // periods start at t = 0: the hand-worked edges below
     return PwmNozzleValves(p, NozzleFlowTable::paper_table3());
 }
 
@@ -140,6 +141,31 @@ TEST(PwmNozzleValves, HowTimeIsCutDoesNotChangeTheVolume) {
         EXPECT_NEAR(a[i], c[i], 1e-12 * a[i]);
         EXPECT_GT(a[i], 0.0);
     }
+}
+
+TEST(PwmNozzleValves, PwmPhaseComesFromTheSeedUnlessGiven) {
+    const auto phase = [](std::uint64_t seed) {
+        PwmValveParams p;
+        p.seed = seed;
+        return PwmNozzleValves(p, NozzleFlowTable::paper_table3()).pwm_phase_s();
+    };
+    EXPECT_EQ(phase(1), phase(1));
+    EXPECT_NE(phase(1), phase(2));
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        EXPECT_GE(phase(seed), 0.0);
+        EXPECT_LT(phase(seed), 1.0 / 9.0);
+    }
+    // With a phase of 50 ms, the first whole period starts at 50 ms: a 100 %
+    // commanded at 0 waits for it (the period before, from -61 ms, latched 0 %).
+    PwmValveParams p;
+    p.pwm_phase_s = 0.05;
+    p.response_s = 0.0;
+    PwmNozzleValves valves(p, NozzleFlowTable::paper_table3());
+    valves.command(0, 100.0, 0);
+    valves.advance(seconds_to_ns(0.05));
+    EXPECT_EQ(valves.delivered_l(0), 0.0);
+    valves.advance(seconds_to_ns(0.15));
+    EXPECT_NEAR(valves.delivered_l(0) * 60000.0, 0.1 * 610.0, 1e-9);
 }
 
 TEST(PwmNozzleValves, BadParametersAndCommandsAreRejected) {
