@@ -47,7 +47,7 @@ void validate(const BoundaryControllerConfig& c) {
     in_range("default_boom_height_m", c.default_boom_height_m, c.lift_hinge_height_m - c.lift_rod_length_m,
              c.lift_hinge_height_m + c.lift_rod_length_m);
     in_range("k_max_cover", c.k_max_cover, 0.0, 1.0, true);
-    in_range("eq12_coefficient", c.eq12_coefficient, 0.0, 10.0, true);
+    in_range("eq12_coefficient_l_min_per_m_s", c.eq12_coefficient_l_min_per_m_s, 0.0, 10.0, true);
     in_range("eq13_slope_l_min_per_pct", c.eq13_slope_l_min_per_pct, 0.0, 1.0, true);
     in_range("eq13_intercept_l_min", c.eq13_intercept_l_min, -10.0, 10.0);
     in_range("level0_max_pct", c.level0_max_pct, -1000.0, 1000.0);

@@ -47,7 +47,7 @@ struct BoundaryControllerConfig {
 
     // Eq. 9-14: q = eq12 D v / k (L/min), s = (q - b) / A (%), levels.
     double k_max_cover = 0.78;            // (0, 1]; k, not given: 0.78 puts the paper's 40 % sparse/normal split on the level 1/2 boundary at 1.5 m/s (assumed)
-    double eq12_coefficient = 0.40968;    // (0, 10]; Eq. 12 = 0.01138 L/m^2 (Eq. 9) x 60 s/min x 0.6 m
+    double eq12_coefficient_l_min_per_m_s = 0.40968;    // (0, 10]; Eq. 12 = 0.01138 L/m^2 (Eq. 9) x 60 s/min x 0.6 m
     double eq13_slope_l_min_per_pct = 0.00375;  // A, (0, 1]; Eq. 13 (Table 3 fit)
     double eq13_intercept_l_min = 0.296;  // b, [-10, 10]; Eq. 13
     double level0_max_pct = -55.0;        // s <= this: level 0, valve closed. Sec. 3.2.2 prints -69 %, but its

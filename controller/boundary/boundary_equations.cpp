@@ -9,7 +9,7 @@
 namespace rig::controller::boundary {
 
 double eq14_theoretical_duty_pct(const BoundaryControllerConfig& c, double density, double speed_m_s) {
-    const double q_l_min = c.eq12_coefficient * density * speed_m_s / c.k_max_cover;  // Eq. 12
+    const double q_l_min = c.eq12_coefficient_l_min_per_m_s * density * speed_m_s / c.k_max_cover;  // Eq. 12
     return (q_l_min - c.eq13_intercept_l_min) / c.eq13_slope_l_min_per_pct;          // Eq. 13 solved for s
 }
 
