@@ -32,6 +32,11 @@ RIG_DECLARE_MSG(BreakpointEvent)
 RIG_DECLARE_MSG(ControllerStatus)
 RIG_DECLARE_MSG(VehicleTruth)
 RIG_DECLARE_MSG(HydraulicsTruth)
+// Seed 001
+RIG_DECLARE_MSG(SerialLine)
+RIG_DECLARE_MSG(NozzlePwm)
+RIG_DECLARE_MSG(Vehicle2dTruth)
+RIG_DECLARE_MSG(NozzlesTruth)
 
 #undef RIG_DECLARE_MSG
 

@@ -20,11 +20,15 @@ inline constexpr const char* kPumpFlowSensor = "device/pump_flow_sensor/voltage"
 inline constexpr const char* kBoomHeightSensor = "device/boom_height_sensor/voltage";  // msg::AnalogInput
 inline constexpr const char* kBreakpointButton = "device/breakpoint_button/level";   // msg::SwitchLevel
 inline constexpr const char* kSpraySwitch = "device/spray_switch/level";             // msg::SwitchLevel
+// Seed 001: the L4 laser boom-height sensor's serial lines (the AD300's RMC uses kGnssNmea).
+inline constexpr const char* kLaserHeightSerial = "device/laser_height/serial";     // msg::SerialLine
 
 // Actuator topics (controller -> plant)
 inline constexpr const char* kBallValveRelays = "actuator/ball_valve/relays";      // msg::BallValveRelays
 inline constexpr const char* kSectionValves = "actuator/section_valves/open";      // msg::SectionValves
 inline constexpr const char* kUnloadingValve = "actuator/unloading_valve/open";    // msg::UnloadingValve
+// Seed 001: PWM duty per nozzle.
+inline constexpr const char* kNozzlePwm = "actuator/nozzle_pwm/duty";              // msg::NozzlePwm
 
 // Controller outputs
 inline constexpr const char* kControllerStatus = "controller/status";          // msg::ControllerStatus
@@ -33,5 +37,8 @@ inline constexpr const char* kBreakpointEvent = "controller/breakpoint_event"; /
 // Truth (plant -> harness, emulators)
 inline constexpr const char* kVehicleTruth = "truth/vehicle";        // msg::VehicleTruth
 inline constexpr const char* kHydraulicsTruth = "truth/hydraulics";  // msg::HydraulicsTruth
+// Seed 001's 2-D plant.
+inline constexpr const char* kVehicle2dTruth = "truth/vehicle2d";    // msg::Vehicle2dTruth
+inline constexpr const char* kNozzlesTruth = "truth/nozzles";        // msg::NozzlesTruth
 
 }  // namespace rig::topics

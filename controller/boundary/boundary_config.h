@@ -1,0 +1,81 @@
+#pragma once
+// Every parameter of the seed-001 reference controller's positioning and
+// boundary half, with its unit (in the name), default and where the value
+// comes from: a paper equation or table, or "assumed" where the paper gives
+// none. validate() checks the bounds given beside each.
+//
+// Seed 001 = Yang et al., "Design of Wheat Variable Spray System Based on
+// Machine Vision and Beidou Positioning", Trans. CSAM 2022, 53(7).
+#include <string>
+#include <vector>
+
+namespace rig::controller::boundary {
+
+struct GeoCorner {
+    double lat_deg = 0.0;  // WGS84, [-80, 84] (UTM's range)
+    double lon_deg = 0.0;  // [-180, 180]
+};
+
+// A target spraying area: four corners recorded with the receiver before work
+// (Sec. 4.2.2), in order around the area.
+struct TargetAreaConfig {
+    std::string name;                  // non-empty, for messages
+    std::vector<GeoCorner> corners;    // >= 3 (the paper records 4)
+    // Plant cover D in [0, 1] (Eq. 17) for the whole area. The vision half
+    // (Sec. 2, 4.1) will measure it per nozzle; until then a case gives it here.
+    double density = 0.5;
+};
+
+struct BoundaryControllerConfig {
+    std::vector<TargetAreaConfig> areas;  // >= 1; the UTM zone is that of the corners' mean
+
+    // Boom (Table 1, Sec. 5.1): nozzles numbered 0.. left to right facing travel (assumed).
+    int nozzle_count = 6;                 // [1, 32]; Sec. 5.1
+    double nozzle_spacing_m = 0.50;       // (0, 5]; Table 1
+    // Eq. 18, the controller's belief of the lift (the plant has its own truth).
+    // The paper gives none of these: assumed, boom centre 1.00 m ahead of the
+    // antenna at H = 0.5 m (see emulators/field2d/boom_lift.h).
+    double lift_rod_length_m = 0.50;      // I, (0, 5]
+    double lift_hinge_height_m = 0.80;    // Hp, (0, 5]
+    double antenna_to_o_m = 0.30;         // M, [-10, 10]
+    double hinge_to_boom_centre_m = 0.90; // L, [-10, 10]
+    double boom_centre_right_of_antenna_m = 0.0;  // [-5, 5]; Sec. 1.1: antenna on the centre line
+
+    // L4 laser (Sec. 1.1): H = D - laser_mount_offset_m.
+    double laser_mount_offset_m = 0.0;    // [-1, 2]; assumed, sensor level with the nozzles
+    double default_boom_height_m = 0.50;  // within the lift's reach; Sec. 5.1, used until the first reading
+
+    // Eq. 9-14: q = eq12 D v / k (L/min), s = (q - b) / A (%), levels.
+    double k_max_cover = 0.78;            // (0, 1]; k, not given: 0.78 puts the paper's 40 % sparse/normal split on the level 1/2 boundary at 1.5 m/s (assumed)
+    double eq12_coefficient_l_min_per_m_s = 0.40968;    // (0, 10]; Eq. 12 = 0.01138 L/m^2 (Eq. 9) x 60 s/min x 0.6 m
+    double eq13_slope_l_min_per_pct = 0.00375;  // A, (0, 1]; Eq. 13 (Table 3 fit)
+    double eq13_intercept_l_min = 0.296;  // b, [-10, 10]; Eq. 13
+    double level0_max_pct = -55.0;        // s <= this: level 0, valve closed. Sec. 3.2.2 prints -69 %, but its
+                                          // own "15 % of full flow" gives -55 % (Eq. 13): -69 is a typo
+    double level1_max_pct = 5.0;          // > level0_max_pct; level 1 up to here (Sec. 3.2.2)
+    double level1_duty_pct = 40.0;        // [0, 100]; Sec. 3.2.2
+    double level2_duty_pct = 100.0;       // [0, 100]; Sec. 3.2.2
+    double pwm_frequency_hz = 9.0;        // (0, 1000]; Sec. 3.2.1
+
+    // AgOpenGPS-style anticipation (not in the paper, off by default): a nozzle
+    // (and the boom-centre rule) switches on when its point lookahead_on_s ahead
+    // (straight on along the course at the current speed) is inside, and off
+    // when both that point and the one lookahead_off_s ahead are outside.
+    // Defaults are AgOpenGPS's setVehicle_toolLookAheadOn / Off (1.0 / 0.5 s).
+    bool lookahead_enabled = false;
+    double lookahead_on_s = 1.0;          // [0, 10], >= lookahead_off_s
+    double lookahead_off_s = 0.5;         // [0, 10]
+
+    // GNSS handling (assumed; the paper says nothing).
+    double course_hold_speed_m_s = 0.2;   // [0, 5]; below this the RMC course is not used, the last one is held
+    double fix_timeout_s = 0.5;           // (0, 10]; no valid RMC for this long: every nozzle off (5 epochs at 10 Hz)
+    // The paper uses the RMC course (true north) as the bearing in UTM (Eq. 19),
+    // ignoring the grid convergence (about 1.3 deg at Wuzhi): false reproduces that.
+    bool correct_grid_convergence = false;
+};
+
+// Throws std::invalid_argument "boundary.<key>: <what>" for the first value
+// out of its bounds (areas are named as areas[i] 'name').
+void validate(const BoundaryControllerConfig& config);
+
+}  // namespace rig::controller::boundary

@@ -1,0 +1,74 @@
+#pragma once
+// Where every part of the seed-001 sprayer is at time t (plant truth): the
+// route's rear-axle pose, the RTK antenna (position, WGS84, and its velocity,
+// which is what a receiver's course and speed over ground measure), the boom
+// height, Eq. 18's boom offset at that height, the boom centre and the six
+// nozzles. A pure function of t, like the route it is built on.
+//
+// Body frame: x metres to the right, y metres forward (seed 001 Fig. 16's xoy).
+// The antenna sits `antenna_forward_of_axle_m` ahead of the rear axle; the boom
+// centre Y1(H) ahead of the antenna (Eq. 18, emulators/field2d/boom_lift.h) on
+// the antenna's line; nozzle i at x_i = (i - (n - 1) / 2) x spacing on the boom,
+// so with 6 nozzles 0.5 m apart (Table 1) nozzle 0 is 1.25 m left of the boom
+// centre and nozzle 5 1.25 m right (numbering left to right facing the travel
+// direction: assumed, the paper's Fig. 16 does not say).
+#include <vector>
+
+#include "emulators/field2d/boom_lift.h"
+#include "emulators/field2d/local_frame.h"
+#include "emulators/field2d/route2d.h"
+#include "emulators/field2d/vec2.h"
+
+namespace rig::field2d {
+
+struct SprayerMounting {
+    // Rear axle to antenna along the heading. Assumed: the paper puts the antenna
+    // ahead of the vehicle centre, 25 cm behind the front wall (Sec. 1.1); for a
+    // 3.2 m long 3WP-280 (Table 2) that is about 1.6 m ahead of the rear axle.
+    double antenna_forward_of_axle_m = 1.60;   // finite
+    double antenna_right_m = 0.0;              // finite; Sec. 1.1: on the vehicle's centre line
+    double antenna_height_m = 1.70;            // > 0; Sec. 1.1: H1 about 170 cm
+    ParallelogramLift lift{};                  // Eq. 18 (assumed lengths, see boom_lift.h)
+    int nozzle_count = 6;                      // 1..32; Sec. 5.1, Table 3
+    double nozzle_spacing_m = 0.50;            // > 0; Table 1
+};
+
+// Throws std::invalid_argument naming the field.
+void validate(const SprayerMounting& mounting);
+
+// x of nozzle i (m right of the boom centre).
+double nozzle_right_m(const SprayerMounting& mounting, int nozzle);
+
+struct SprayerTruth {
+    VehiclePose2d pose;                 // rear-axle centre
+    Vec2 antenna;                       // antenna's ground point, local east/north
+    GeodeticPoint antenna_geodetic;     // antenna phase centre, WGS84 (height_m above the ellipsoid)
+    Vec2 antenna_velocity_m_s;          // east/north components, m/s
+    double boom_height_m = 0.0;         // H, truth
+    double boom_offset_m = 0.0;         // Y1(H), Eq. 18
+    Vec2 boom_centre;                   // ground point under the boom centre
+    std::vector<Vec2> nozzles;          // ground points under each nozzle, index = nozzle number
+};
+
+class SprayerKinematics {
+public:
+    // Throws std::invalid_argument for a bad mounting or a height profile the
+    // lift cannot reach (naming the height and the lift's range).
+    SprayerKinematics(LocalFrame frame, Route2d route, SprayerMounting mounting, BoomHeightProfile height);
+
+    SprayerTruth truth_at(double t_s) const;
+    double boom_height_at(double t_s) const { return height_.height_at(t_s); }
+
+    const LocalFrame& frame() const { return frame_; }
+    const Route2d& route() const { return route_; }
+    const SprayerMounting& mounting() const { return mounting_; }
+    const BoomHeightProfile& height_profile() const { return height_; }
+
+private:
+    LocalFrame frame_;
+    Route2d route_;
+    SprayerMounting mounting_;
+    BoomHeightProfile height_;
+};
+
+}  // namespace rig::field2d

@@ -1,0 +1,186 @@
+// Seed 001's boundary and flow metrics (harness/boundary_metrics.h) on plain
+// data with known answers: the paper's own Table 7 / 8 values for the
+// statistics, hand-made rasters for the wet edge, Table 3 for Eq. 13's fit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "emulators/field2d/nozzle_flow_table.h"
+#include "harness/boundary_metrics.h"
+
+namespace {
+
+using namespace rig::harness;
+
+// A 2 cm raster over east [-2, 2) x north [-2, 2), wet (dose 1 uL/cm^2) where `wet(e, n)` says so.
+template <class Fn>
+DoseRaster raster_where(Fn wet) {
+    DoseRaster r;
+    r.east0_m = -2.0;
+    r.north0_m = -2.0;
+    r.cell_m = 0.02;
+    r.nx = 200;
+    r.ny = 200;
+    r.dose_ul_cm2.assign(r.nx * r.ny, 0.0);
+    for (std::size_t iy = 0; iy < r.ny; ++iy) {
+        for (std::size_t ix = 0; ix < r.nx; ++ix) {
+            const double e = r.east0_m + (static_cast<double>(ix) + 0.5) * r.cell_m;
+            const double n = r.north0_m + (static_cast<double>(iy) + 0.5) * r.cell_m;
+            if (wet(e, n)) r.dose_ul_cm2[iy * r.nx + ix] = 1.0;
+        }
+    }
+    return r;
+}
+
+// The edge along north = 0 with the area to the south: from east +1 to east -1
+// (heading west, the outside - north - is to the right).
+constexpr BoundaryEdge kNorthEdge{1.0, 0.0, -1.0, 0.0};
+
+TEST(BoundaryMetrics, SummaryIsMeanAndSampleSdLikeThePaper) {
+    // Table 7, 0.5 m/s, cm: sum 536 over 11 points, mean 48.727 (printed 48.72);
+    // squared deviations sum to 36.18, / 10 -> SD 1.902 (printed 1.90).
+    const Summary t7 = summarize({50, 48, 47, 52, 50, 50, 45, 48, 48, 48, 50});
+    EXPECT_EQ(t7.n, 11u);
+    EXPECT_NEAR(t7.mean, 536.0 / 11.0, 1e-12);
+    EXPECT_NEAR(t7.sd, 1.902, 0.001);
+    EXPECT_EQ(t7.min, 45.0);
+    EXPECT_EQ(t7.max, 52.0);
+    // Table 8, driving in: sum 80, mean 7.27 (printed 7.20), SD 1.489 (printed 1.48).
+    const Summary t8 = summarize({7, 5, 10, 5, 7, 8, 7, 9, 8, 7, 7});
+    EXPECT_NEAR(t8.mean, 80.0 / 11.0, 1e-12);
+    EXPECT_NEAR(t8.sd, 1.489, 0.001);
+    // NaN (a dry station) is skipped; one value has no SD.
+    const Summary one = summarize({NAN, 3.0, NAN});
+    EXPECT_EQ(one.n, 1u);
+    EXPECT_EQ(one.mean, 3.0);
+    EXPECT_TRUE(std::isnan(one.sd));
+    EXPECT_TRUE(std::isnan(summarize({}).mean));
+}
+
+TEST(BoundaryMetrics, ANozzleClosing0_1sLateAt1MetrePerSecondOverruns0_1m) {
+    // Spray up to 0.1 m past the edge (1 m/s x 0.1 s), 2.2 m wide (beyond the 2 m edge).
+    const DoseRaster r = raster_where([](double e, double n) { return n < 0.1 && std::abs(e) < 1.1; });
+    EdgeProbe probe;  // every 0.5 m from the edge's start: stations 0, 0.5, 1.0, 1.5, 2.0
+    const EdgeProfile profile = wet_edge_profile(r, kNorthEdge, probe);
+    ASSERT_EQ(profile.excess_m.size(), 5u);
+    for (std::size_t i = 0; i < 5; ++i) {
+        EXPECT_DOUBLE_EQ(profile.station_m[i], 0.5 * static_cast<double>(i));
+        // Probes every 5 mm; the edge taken between the last wet (0.095) and the
+        // first dry (0.100) probe: 0.0975, within a quarter cell of 0.1.
+        EXPECT_NEAR(profile.excess_m[i], 0.1, 0.005) << "station " << i;
+    }
+    const auto m = excess_metrics("boundary_overrun", profile);
+    EXPECT_NEAR(m.at("boundary_overrun_mean_m"), 0.1, 0.005);
+    EXPECT_NEAR(m.at("boundary_overrun_sd_m"), 0.0, 1e-12);
+    EXPECT_EQ(m.at("boundary_overrun_stations"), 5.0);
+    EXPECT_EQ(m.at("boundary_overrun_stations_dry"), 0.0);
+}
+
+TEST(BoundaryMetrics, ShortSprayIsNegativeAndUnreachedStationsAreDry) {
+    // Driving in: the spray began 0.2 m inside; only east in [-0.3, 1) was sprayed.
+    const DoseRaster r = raster_where([](double e, double n) { return n < -0.2 && e > -0.3 && e < 1.0; });
+    const EdgeProfile p = wet_edge_profile(r, kNorthEdge);
+    // Stations at east 1.0 (the cell edge: east 1.0 itself is dry), 0.5, 0, -0.5, -1.0.
+    EXPECT_TRUE(std::isnan(p.excess_m[0]));
+    EXPECT_NEAR(p.excess_m[1], -0.2, 0.005);
+    EXPECT_NEAR(p.excess_m[2], -0.2, 0.005);
+    EXPECT_TRUE(std::isnan(p.excess_m[3]));
+    EXPECT_TRUE(std::isnan(p.excess_m[4]));
+    const auto m = excess_metrics("drive_in_excess", p);
+    EXPECT_NEAR(m.at("drive_in_excess_mean_m"), -0.2, 0.005);
+    EXPECT_EQ(m.at("drive_in_excess_stations"), 2.0);
+    EXPECT_EQ(m.at("drive_in_excess_stations_dry"), 3.0);
+    // No wet station at all: mean and SD are absent (a limit on them fails as missing).
+    const auto dry = excess_metrics("drive_out_excess", wet_edge_profile(raster_where([](double, double) { return false; }), kNorthEdge));
+    EXPECT_EQ(dry.count("drive_out_excess_mean_m"), 0u);
+    EXPECT_EQ(dry.count("drive_out_excess_sd_m"), 0u);
+    EXPECT_EQ(dry.at("drive_out_excess_stations_dry"), 5.0);
+}
+
+TEST(BoundaryMetrics, SlantedEdge) {
+    // An edge through the origin running north-west, outside to the north-east:
+    // wet where the distance past it, (e + n) / sqrt 2, is below 0.3 m.
+    const BoundaryEdge edge{1.0, -1.0, -1.0, 1.0};
+    const DoseRaster r = raster_where([](double e, double n) { return (e + n) / std::sqrt(2.0) < 0.3; });
+    EdgeProbe probe;
+    probe.from_m = 0.5;
+    probe.to_m = 2.0;
+    const EdgeProfile p = wet_edge_profile(r, edge, probe);
+    ASSERT_EQ(p.excess_m.size(), 4u);
+    // Cells are wet by their centre: the staircase edge is within half a cell
+    // diagonal (1.4 cm) of the true one.
+    for (double x : p.excess_m) EXPECT_NEAR(x, 0.3, 0.015);
+}
+
+TEST(BoundaryMetrics, PerNozzleNames) {
+    const DoseRaster wet_far = raster_where([](double, double n) { return n < 0.3; });
+    const DoseRaster wet_near = raster_where([](double, double n) { return n < 0.1; });
+    const DoseRaster dry = raster_where([](double, double) { return false; });
+    const auto m = per_nozzle_excess_metrics(
+        "boundary_overrun", {wet_edge_profile(wet_near, kNorthEdge), wet_edge_profile(wet_far, kNorthEdge),
+                             wet_edge_profile(dry, kNorthEdge)});
+    EXPECT_NEAR(m.at("boundary_overrun_nozzle0_mean_m"), 0.1, 0.005);
+    EXPECT_NEAR(m.at("boundary_overrun_nozzle1_max_m"), 0.3, 0.005);
+    EXPECT_EQ(m.at("boundary_overrun_nozzle2_stations"), 0.0);
+    EXPECT_EQ(m.count("boundary_overrun_nozzle2_mean_m"), 0u);
+    // The ground's total is the sum of the layers: its edge is the farthest one.
+    const DoseRaster total = sum_rasters({wet_near, wet_far, dry});
+    EXPECT_NEAR(wet_edge_profile(total, kNorthEdge).excess_m[2], 0.3, 0.005);
+}
+
+TEST(BoundaryMetrics, BadInputIsRejected) {
+    DoseRaster r = raster_where([](double, double) { return false; });
+    EXPECT_THROW(wet_edge_profile(r, BoundaryEdge{1, 1, 1, 1}), std::invalid_argument);
+    EdgeProbe probe;
+    probe.spacing_m = 0.0;
+    EXPECT_THROW(wet_edge_profile(r, kNorthEdge, probe), std::invalid_argument);
+    r.dose_ul_cm2.pop_back();
+    EXPECT_THROW(wet_edge_profile(r, kNorthEdge), std::invalid_argument);
+    DoseRaster other = raster_where([](double, double) { return false; });
+    other.cell_m = 0.01;
+    EXPECT_THROW(sum_rasters({raster_where([](double, double) { return false; }), other}), std::invalid_argument);
+}
+
+TEST(FlowMetrics, DeliveredAgainstTable3) {
+    const auto table = rig::field2d::NozzleFlowTable::paper_table3();
+    // Nozzle 0 at 40 %: 0.390 L in 60 s is Table 3's 390 mL/min; nozzle 3 at
+    // 95 % (interpolated 635) delivering 10 % more; 10 % duty is outside the table.
+    const std::vector<FlowCheckRow> rows = flow_against_table(
+        {{0, 40.0, 0.390, 60.0}, {3, 95.0, 0.6985, 60.0}, {1, 10.0, 0.05, 60.0}}, table);
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_NEAR(rows[0].delivered_ml_min, 390.0, 1e-9);
+    EXPECT_NEAR(rows[0].error_pct, 0.0, 1e-9);
+    EXPECT_NEAR(rows[1].table_ml_min, 635.0, 1e-9);
+    EXPECT_NEAR(rows[1].error_pct, 10.0, 1e-9);
+    EXPECT_TRUE(std::isnan(rows[2].table_ml_min));
+    const auto m = flow_table_metrics(rows);
+    EXPECT_EQ(m.at("flow_table_points"), 2.0);
+    EXPECT_NEAR(m.at("flow_table_max_abs_error_pct"), 10.0, 1e-9);
+    EXPECT_NEAR(m.at("flow_table_mean_abs_error_pct"), 5.0, 1e-9);
+    EXPECT_THROW(flow_against_table({{6, 40.0, 0.3, 60.0}}, table), std::invalid_argument);
+    EXPECT_THROW(flow_against_table({{0, 40.0, 0.3, 0.0}}, table), std::invalid_argument);
+}
+
+TEST(FlowMetrics, Eq13FitOfTable3IsThePapers) {
+    // Table 3 delivered exactly: the fit over the nozzles' means at 30-80 % duty
+    // is the paper's q = 0.00375 s + 0.296 (Eq. 13): means 406.67 ... 593.33,
+    // Sxx = 1750, Sxy = 6562.5 -> A = 3.75 mL/min per %, b = 502.64 - 3.75 x 55 = 296.4 mL/min.
+    const auto table = rig::field2d::NozzleFlowTable::paper_table3();
+    std::vector<FlowRecord> records;
+    for (int n = 0; n < 6; ++n) {
+        for (double d : {30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0}) {
+            records.push_back({n, d, table.flow_ml_min(n, d) / 1000.0, 60.0});
+        }
+    }
+    const auto m = eq13_fit_metrics(flow_against_table(records, table));
+    EXPECT_EQ(m.at("eq13_points"), 6.0);
+    EXPECT_NEAR(m.at("eq13_slope_l_min_per_pct"), 0.00375, 1e-6);
+    EXPECT_NEAR(m.at("eq13_intercept_l_min"), 0.296, 0.0005);
+    EXPECT_GT(m.at("eq13_r2"), 0.99);
+    EXPECT_THROW(fit_line({1.0, 1.0}, {2.0, 3.0}), std::invalid_argument);
+}
+
+}  // namespace
