@@ -16,7 +16,7 @@
 #include <unordered_set>
 #include <utility>
 
-#include "rig/file_access.h"
+#include "rig/config/file_access.h"
 
 namespace rig::controller {
 

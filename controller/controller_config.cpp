@@ -3,7 +3,7 @@
 #include <array>
 
 #include "controller/breakpoint_store.h"
-#include "rig/yaml_fields.h"
+#include "rig/config/yaml_fields.h"
 
 namespace rig::controller {
 

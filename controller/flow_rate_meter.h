@@ -14,7 +14,7 @@
 #include <deque>
 #include <optional>
 
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::controller {
 

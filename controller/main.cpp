@@ -23,10 +23,10 @@
 #include "controller/controller_config.h"
 #include "controller/reference_controller.h"
 #include "controller/wired_board_controller.h"
-#include "rig/dds_context.h"
-#include "rig/lockstep.h"
-#include "rig/modbus_protocol.h"
-#include "rig/realtime.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/lockstep.h"
+#include "rig/wire/modbus_protocol.h"
+#include "rig/runtime/realtime.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Reference breakpoint-spraying controller (seed 000) as a rig node"};

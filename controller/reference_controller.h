@@ -19,10 +19,10 @@
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
-#include "rig/actuator_topics.h"
-#include "rig/board_input_topics.h"
-#include "rig/dds_context.h"
-#include "rig/node.h"
+#include "rig/runtime/actuator_topics.h"
+#include "rig/runtime/board_input_topics.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
 
 namespace rig::controller {
 

@@ -6,7 +6,7 @@
 
 #include "controller/breakpoint_equations.h"
 #include "controller/flow_equations.h"
-#include "controller/nmea_parser.h"
+#include "rig/nmea/nmea_parser.h"
 
 namespace rig::controller {
 

@@ -45,8 +45,8 @@
 #include "controller/valve_calibration.h"
 #include "controller/valve_driver.h"
 #include "controllerPubSubTypes.h"
-#include "rig/clock.h"
-#include "rig/io_image.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/io_image.h"
 
 namespace rig::controller {
 

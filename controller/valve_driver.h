@@ -13,7 +13,7 @@
 // whatever it was before.
 #include <optional>
 
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::controller {
 

@@ -18,9 +18,9 @@
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
-#include "rig/modbus_master.h"
-#include "rig/node.h"
-#include "rig/serial_port.h"
+#include "rig/wire/modbus_master.h"
+#include "rig/runtime/node.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig::controller {
 

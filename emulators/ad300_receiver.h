@@ -15,7 +15,7 @@
 //             falls (about velocity_noise / v rad: 0.8 deg at 1.5 m/s, 11 deg at
 //             0.1 m/s with the defaults), and below min_course_speed_m_s the
 //             course field is left empty, as receivers do when nearly still.
-// The RMC sentence (emulators/nmea_encoder.h) is on the wire latency_s after
+// The RMC sentence (rig/nmea/nmea_encoder.h) is on the wire latency_s after
 // its epoch. The epoch phase, unless given, is drawn from the seed (stream
 // "ad300.epoch_phase"), so a case's seed decides where the epochs fall
 // relative to the area's edge; the noise uses stream "ad300.noise".
@@ -25,10 +25,10 @@
 #include <vector>
 
 #include "emulators/field2d/sprayer_kinematics.h"
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 #include "emulators/seeded_random.h"
 #include "emulators/timed_line.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

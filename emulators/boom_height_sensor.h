@@ -7,8 +7,8 @@
 #include <string>
 
 #include "emulators/plant.h"
-#include "rig/dds_context.h"
-#include "rig/node.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
 
 namespace rig::emulators {
 

@@ -18,7 +18,7 @@
 #include "emulators/field2d/deposition_grid2d.h"
 #include "emulators/field2d/sprayer_kinematics.h"
 #include "emulators/pwm_nozzle_valves.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

@@ -17,8 +17,8 @@
 #include <string>
 
 #include "emulators/spray_circuit.h"
-#include "rig/dds_context.h"
-#include "rig/node.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
 
 namespace rig::emulators {
 

@@ -3,7 +3,7 @@
 // RTK 8 mm + 1 ppm). Each epoch it samples the plant's antenna position, applies
 // the receiver's error model and faults, and sends GGA then RMC on the wire
 // `latency_s` after the epoch. The fix (data) and NMEA (wire format,
-// emulators/nmea_encoder.h) are kept apart.
+// rig/nmea/nmea_encoder.h) are kept apart.
 //
 // Faults, all named per-device parameters:
 //   latency_s  epoch -> sentences on the wire
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 #include "emulators/plant.h"
 #include "emulators/seeded_random.h"
 

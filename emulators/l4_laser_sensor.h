@@ -26,7 +26,7 @@
 #include "emulators/field2d/sprayer_kinematics.h"
 #include "emulators/seeded_random.h"
 #include "emulators/timed_line.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The G970II's RS232 output on a real wire: puts NMEA sentences (already framed
-// "$...*HH\r\n" by emulators/nmea_encoder.h) on a SerialPort, byte for byte what
+// "$...*HH\r\n" by rig/nmea/nmea_encoder.h) on a SerialPort, byte for byte what
 // a receiver transmits, and says how long each one occupies the wire at the
 // port's baud and frame format (10 bits per byte for 8N1), so the real-time loop
 // that calls it can account for it (a 90-byte GGA at 9600 baud is 94 ms: at
@@ -15,8 +15,8 @@
 #include <string>
 #include <string_view>
 
-#include "rig/clock.h"
-#include "rig/serial_port.h"
+#include "rig/runtime/clock.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig::emulators {
 

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "rig/clock.h"
-#include "rig/dds_context.h"
-#include "rig/node.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
 
 namespace rig::emulators {
 

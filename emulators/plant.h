@@ -9,9 +9,9 @@
 #include "emulators/field_frame.h"
 #include "emulators/land_wheel.h"
 #include "emulators/vehicle_plant.h"
-#include "rig/clock.h"
-#include "rig/dds_context.h"
-#include "rig/node.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
 
 namespace rig::emulators {
 

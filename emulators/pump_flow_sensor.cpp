@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "idl/topics.h"
-#include "rig/io_image.h"
+#include "rig/runtime/io_image.h"
 
 namespace rig::emulators {
 

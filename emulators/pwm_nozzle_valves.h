@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "emulators/field2d/nozzle_flow_table.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

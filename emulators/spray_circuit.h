@@ -40,7 +40,7 @@
 #include "emulators/deposition_grid.h"
 #include "emulators/flow_map.h"
 #include "emulators/plant.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

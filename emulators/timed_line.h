@@ -3,7 +3,7 @@
 // byte is there (what a reader of that wire sees, and when).
 #include <string>
 
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::emulators {
 

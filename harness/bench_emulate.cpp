@@ -8,11 +8,11 @@
 #include "emulators/gnss_g970.h"
 #include "harness/case_world.h"
 #include "harness/case_spec.h"
-#include "rig/domain_lease.h"
-#include "rig/pty_pair.h"
-#include "rig/realtime.h"
-#include "rig/stop_signals.h"
-#include "rig/wire_adapters.h"
+#include "rig/host/domain_lease.h"
+#include "rig/wire/pty_pair.h"
+#include "rig/runtime/realtime.h"
+#include "rig/host/stop_signals.h"
+#include "rig/wire/wire_adapters.h"
 
 namespace rig::harness {
 

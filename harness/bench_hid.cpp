@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "rig/hid_board.h"
+#include "rig/wire/hid_board.h"
 
 namespace rig::harness {
 

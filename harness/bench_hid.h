@@ -1,6 +1,6 @@
 #pragma once
 // `rig hid list [--vid 0x1209] [--pid 0x0001]`: lists the USB-HID bench I/O
-// boards (rig/hid_board.h) attached to this machine, one per line:
+// boards (rig/wire/hid_board.h) attached to this machine, one per line:
 //   1209:0001 /dev/hidraw3 "rig bench" "sprayer HIL I/O board" serial 0042 interface 0
 // Exit 0 when at least one is found; otherwise 1 and
 //   rig hid list: no HID I/O board VID:PID 1209:0001 found (3 HID devices present)

@@ -13,8 +13,8 @@
 #include <optional>
 #include <sstream>
 
-#include "rig/clock.h"
-#include "rig/modbus_slave.h"
+#include "rig/runtime/clock.h"
+#include "rig/wire/modbus_slave.h"
 
 namespace rig::harness {
 namespace {

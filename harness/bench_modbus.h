@@ -13,7 +13,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "rig/io_image.h"
+#include "rig/runtime/io_image.h"
 
 namespace CLI {
 class App;

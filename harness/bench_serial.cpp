@@ -12,9 +12,9 @@
 #include <iostream>
 #include <optional>
 
-#include "rig/pty_pair.h"
-#include "rig/stop_signals.h"
-#include "rig/serial_port.h"
+#include "rig/wire/pty_pair.h"
+#include "rig/host/stop_signals.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig::harness {
 namespace {

@@ -3,7 +3,7 @@
 // script (a null-modem cable between two programs that only speak serial).
 //
 //   rig pty [--link-a PATH] [--link-b PATH] [--baud N] [--frame 8N1]
-//       Creates a linked pair (rig/pty_pair.h PtyLink), prints both slave paths
+//       Creates a linked pair (rig/wire/pty_pair.h PtyLink), prints both slave paths
 //       (and the symlinks), forwards until SIGINT/SIGTERM, exits 0.
 //   rig pty --single [--link-a PATH]
 //       One pty: what a program writes to it appears on standard output, and

@@ -21,9 +21,9 @@
 #include "harness/run_interrupt.h"
 #include "harness/trace_recorder.h"
 #include "idl/topics.h"
-#include "rig/lockstep.h"
-#include "rig/realtime.h"
-#include "rig/wire_adapters.h"
+#include "rig/runtime/lockstep.h"
+#include "rig/runtime/realtime.h"
+#include "rig/wire/wire_adapters.h"
 
 namespace rig::harness {
 
@@ -137,7 +137,7 @@ LockstepTimeouts timeouts_of(const CaseSpec& spec) {
     return timeouts;
 }
 
-// Lockstep: virtual time, jumping from wake-up to wake-up (rig/lockstep.h).
+// Lockstep: virtual time, jumping from wake-up to wake-up (rig/runtime/lockstep.h).
 void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
@@ -161,7 +161,7 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     }
 }
 
-// Real time: the wall clock, for a board on real wires (rig/realtime.h).
+// Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
 void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {

@@ -4,8 +4,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "rig/hid_board.h"
-#include "rig/modbus_protocol.h"
+#include "rig/wire/hid_board.h"
+#include "rig/wire/modbus_protocol.h"
 
 namespace rig::harness {
 

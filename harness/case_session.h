@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "harness/case_spec.h"
-#include "rig/child_process.h"
-#include "rig/clock.h"
-#include "rig/domain_lease.h"
-#include "rig/pty_pair.h"
-#include "rig/serial_port.h"
-#include "rig/wire_adapters.h"
+#include "rig/host/child_process.h"
+#include "rig/runtime/clock.h"
+#include "rig/host/domain_lease.h"
+#include "rig/wire/pty_pair.h"
+#include "rig/wire/serial_port.h"
+#include "rig/wire/wire_adapters.h"
 
 namespace rig::harness {
 

@@ -1,9 +1,9 @@
 #include "harness/case_spec.h"
 
 #include "emulators/land_wheel.h"
-#include "rig/file_access.h"
-#include "rig/lockstep.h"
-#include "rig/modbus_protocol.h"
+#include "rig/config/file_access.h"
+#include "rig/runtime/lockstep.h"
+#include "rig/wire/modbus_protocol.h"
 
 #include <algorithm>
 #include <cctype>
@@ -682,7 +682,7 @@ CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& fil
 }
 
 CaseSpec load_case_file(const std::filesystem::path& path, const std::map<std::string, double>& default_limits) {
-    // Read once, by type and bounded (rig/file_access.h), then parsed from memory;
+    // Read once, by type and bounded (rig/config/file_access.h), then parsed from memory;
     // the text is kept for the trace.
     std::string text;
     try {

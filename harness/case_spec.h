@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "rig/config_error.h"
-#include "rig/yaml_fields.h"
+#include "rig/config/config_error.h"
+#include "rig/config/yaml_fields.h"
 
 namespace rig::harness {
 

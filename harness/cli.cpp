@@ -13,7 +13,7 @@
 #include <iostream>
 #include <unistd.h>
 
-#include "controller/nmea_decode_tool.h"
+#include "harness/nmea_decode_tool.h"
 #include "harness/bench_emulate.h"
 #include "harness/bench_hid.h"
 #include "harness/bench_modbus.h"
@@ -24,9 +24,9 @@
 #include "harness/judge_command.h"
 #include "harness/results_writer.h"
 #include "harness/run_interrupt.h"
-#include "rig/clock.h"
-#include "rig/config_error.h"
-#include "rig/dds_check.h"
+#include "rig/runtime/clock.h"
+#include "rig/config/config_error.h"
+#include "rig/host/dds_check.h"
 
 namespace {
 

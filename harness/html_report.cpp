@@ -16,7 +16,7 @@
 #include <system_error>
 #include <utility>
 
-#include "rig/child_process.h"
+#include "rig/host/child_process.h"
 
 namespace rig::harness {
 

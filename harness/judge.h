@@ -18,7 +18,7 @@
 #include "harness/html_report.h"
 #include "harness/metrics.h"
 #include "harness/results_writer.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::harness {
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "emulators/field_frame.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::harness {
 

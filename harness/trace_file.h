@@ -26,8 +26,8 @@
 
 #include "emulators/deposition_grid.h"
 #include "emulators/spray_circuit.h"
-#include "rig/clock.h"
-#include "rig/dds_context.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
 
 struct sqlite3;
 struct sqlite3_stmt;

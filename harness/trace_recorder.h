@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/trace_file.h"
-#include "rig/dds_context.h"
+#include "rig/runtime/dds_context.h"
 
 namespace rig::harness {
 

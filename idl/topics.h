@@ -4,11 +4,11 @@
 // by the controller). Types live in the .idl files beside this header.
 namespace rig::topics {
 
-// Time (rig/lockstep.h)
+// Time (rig/runtime/lockstep.h)
 inline constexpr const char* kClockTick = "rig/clock/tick";          // msg::ClockTick
 inline constexpr const char* kClockAck = "rig/clock/ack";            // msg::ClockAck
 
-// Bench self-test (rig/dds_check.h)
+// Bench self-test (rig/host/dds_check.h)
 inline constexpr const char* kDdsCheckPing = "rig/dds_check/ping";  // msg::NmeaSentence
 inline constexpr const char* kDdsCheckPong = "rig/dds_check/pong";  // msg::NmeaSentence
 

@@ -9,7 +9,7 @@
 #include <variant>
 #include <vector>
 
-#include "controller/nmea_parser.h"
+#include "rig/nmea/nmea_parser.h"
 #include "emulators/ad300_receiver.h"
 #include "emulators/field2d/sprayer_kinematics.h"
 

@@ -12,9 +12,9 @@
 #include <string>
 #include <thread>
 
-#include "rig/child_process.h"
-#include "rig/clock.h"
-#include "rig/serial_port.h"
+#include "rig/host/child_process.h"
+#include "rig/runtime/clock.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig {
 namespace {

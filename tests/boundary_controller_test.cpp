@@ -16,7 +16,7 @@
 #include "controller/boundary/utm_area.h"
 #include "emulators/field2d/local_frame.h"
 #include "emulators/field2d/vec2.h"
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 
 namespace {
 

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "controller/controller_config.h"
-#include "rig/config_error.h"
-#include "rig/yaml_fields.h"
+#include "rig/config/config_error.h"
+#include "rig/config/yaml_fields.h"
 
 namespace rig::harness {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
 // A HidTransport that behaves like the bench I/O board's firmware
-// (rig/hid_board_protocol.h), for machines without the board: it decodes the
+// (rig/wire/hid_board_protocol.h), for machines without the board: it decodes the
 // rig's command reports, emits pulses on its two outputs by the protocol's
 // spreading rule on its own simulated clock, and sends status reports carrying
 // relay inputs the test sets.
@@ -15,9 +15,9 @@
 #include <optional>
 #include <vector>
 
-#include "rig/hid_board.h"
-#include "rig/hid_board_protocol.h"
-#include "rig/io_image.h"
+#include "rig/wire/hid_board.h"
+#include "rig/wire/hid_board_protocol.h"
+#include "rig/runtime/io_image.h"
 
 namespace rig::testing {
 

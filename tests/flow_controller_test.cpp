@@ -24,7 +24,7 @@
 #include "controller/valve_calibration.h"
 #include "controller/valve_driver.h"
 #include "emulators/field_frame.h"
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 #include "emulators/plant.h"
 #include "emulators/pump_flow_sensor.h"
 #include "emulators/spray_circuit.h"

@@ -11,8 +11,8 @@
 #include "emulators/flow_meter_kf11.h"
 #include "emulators/plant.h"
 #include "emulators/spray_circuit.h"
-#include "rig/dds_context.h"
-#include "rig/domain_lease.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/host/domain_lease.h"
 
 namespace {
 

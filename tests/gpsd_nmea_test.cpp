@@ -1,7 +1,7 @@
 // A real NMEA client no one here wrote (Debian's gpsd) reads the stream the rig
 // writes into a pty and reports the positions that were written.
 //
-// GGA + RMC epochs from emulators/nmea_encoder.h, RTK fixed (quality 4), 5 Hz,
+// GGA + RMC epochs from rig/nmea/nmea_encoder.h, RTK fixed (quality 4), 5 Hz,
 // along a short straight line near 40.18 N 116.44 E, go through
 // NmeaSerialSink into a PtyPair whose slave gpsd reads (`gpsd -N -n -b`, on a
 // free port on 127.0.0.1). A TCP client on 127.0.0.1 asks for JSON reports
@@ -32,11 +32,11 @@
 #include <thread>
 #include <vector>
 
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 #include "emulators/nmea_serial_sink.h"
-#include "rig/child_process.h"
-#include "rig/clock.h"
-#include "rig/pty_pair.h"
+#include "rig/host/child_process.h"
+#include "rig/runtime/clock.h"
+#include "rig/wire/pty_pair.h"
 
 namespace rig {
 namespace {

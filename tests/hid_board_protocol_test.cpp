@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rig/hid_board_protocol.h"
+#include "rig/wire/hid_board_protocol.h"
 
 namespace rig::hid {
 namespace {

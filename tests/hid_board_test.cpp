@@ -12,7 +12,7 @@
 #include <random>
 #include <string>
 
-#include "rig/hid_board.h"
+#include "rig/wire/hid_board.h"
 #include "tests/fake_hid_board.h"
 
 namespace rig {

@@ -4,10 +4,10 @@
 
 #include <map>
 
-#include "rig/child_process.h"
-#include "rig/dds_context.h"
-#include "rig/domain_lease.h"
-#include "rig/lockstep.h"
+#include "rig/host/child_process.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/host/domain_lease.h"
+#include "rig/runtime/lockstep.h"
 
 namespace {
 

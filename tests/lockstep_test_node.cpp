@@ -6,8 +6,8 @@
 #include <iostream>
 #include <string>
 
-#include "rig/dds_context.h"
-#include "rig/lockstep.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/lockstep.h"
 
 namespace {
 

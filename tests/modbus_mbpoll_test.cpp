@@ -12,7 +12,7 @@
 #include <string>
 
 #include "modbus_test_support.h"
-#include "rig/modbus_slave.h"
+#include "rig/wire/modbus_slave.h"
 
 namespace rig::modbus {
 namespace {

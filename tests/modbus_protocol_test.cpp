@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "rig/modbus_protocol.h"
+#include "rig/wire/modbus_protocol.h"
 
 namespace rig::modbus {
 namespace {

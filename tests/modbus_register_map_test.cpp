@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rig/modbus_register_map.h"
+#include "rig/wire/modbus_register_map.h"
 
 namespace rig::modbus {
 namespace {

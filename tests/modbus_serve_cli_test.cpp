@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "harness/bench_modbus.h"
-#include "rig/modbus_register_map.h"
+#include "rig/wire/modbus_register_map.h"
 #include "modbus_test_support.h"
-#include "rig/child_process.h"
-#include "rig/modbus_master.h"
+#include "rig/host/child_process.h"
+#include "rig/wire/modbus_master.h"
 
 namespace rig::harness {
 namespace {

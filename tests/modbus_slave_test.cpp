@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "modbus_test_support.h"
-#include "rig/clock.h"
-#include "rig/modbus_master.h"
-#include "rig/modbus_slave.h"
+#include "rig/runtime/clock.h"
+#include "rig/wire/modbus_master.h"
+#include "rig/wire/modbus_slave.h"
 
 namespace rig::modbus {
 namespace {

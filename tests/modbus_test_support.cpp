@@ -21,7 +21,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::modbus::testing {
 namespace {

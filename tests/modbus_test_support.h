@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "rig/child_process.h"
+#include "rig/host/child_process.h"
 
 namespace rig::modbus::testing {
 

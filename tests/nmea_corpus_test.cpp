@@ -64,7 +64,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "controller/nmea_parser.h"
+#include "rig/nmea/nmea_parser.h"
 
 namespace rig::nmea {
 namespace {

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "controller/nmea_decode_tool.h"
+#include "harness/nmea_decode_tool.h"
 
 namespace rig::nmea {
 namespace {

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "controller/nmea_parser.h"
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_parser.h"
+#include "rig/nmea/nmea_encoder.h"
 
 namespace rig::nmea {
 namespace {

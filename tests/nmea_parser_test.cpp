@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "controller/nmea_parser.h"
+#include "rig/nmea/nmea_parser.h"
 
 namespace rig::nmea {
 namespace {

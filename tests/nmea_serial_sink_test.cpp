@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "emulators/nmea_encoder.h"
+#include "rig/nmea/nmea_encoder.h"
 #include "emulators/nmea_serial_sink.h"
-#include "rig/pty_pair.h"
-#include "rig/serial_port.h"
+#include "rig/wire/pty_pair.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig::emulators {
 namespace {

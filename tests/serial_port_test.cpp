@@ -16,8 +16,8 @@
 #include <thread>
 #include <vector>
 
-#include "rig/pty_pair.h"
-#include "rig/serial_port.h"
+#include "rig/wire/pty_pair.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig {
 namespace {

@@ -19,9 +19,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "controller/nmea_parser.h"
-#include "rig/child_process.h"
-#include "rig/serial_port.h"
+#include "rig/nmea/nmea_parser.h"
+#include "rig/host/child_process.h"
+#include "rig/wire/serial_port.h"
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <GeographicLib/Math.hpp>
 
 #include "controller/boundary/l4_laser_parser.h"
-#include "controller/nmea_parser.h"
+#include "rig/nmea/nmea_parser.h"
 
 namespace rig::controller::boundary {
 namespace {

@@ -31,7 +31,7 @@
 #include "controller/boundary/boundary_config.h"
 #include "controller/boundary/boundary_equations.h"
 #include "controller/boundary/utm_area.h"
-#include "rig/clock.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::controller::boundary {
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: the case-file loader (harness/case_spec.h parse_case on
-// top of rig/yaml_fields.h) and, as `rig run` does before anything starts, the
+// top of rig/config/yaml_fields.h) and, as `rig run` does before anything starts, the
 // reference controller's check of its own `controller:` section.
 // Any input must give a spec or a rig::ConfigError that names the file and
 // says something; any other exception escaping is a finding.
@@ -10,8 +10,8 @@
 
 #include "controller/controller_config.h"
 #include "harness/case_spec.h"
-#include "rig/config_error.h"
-#include "rig/yaml_fields.h"
+#include "rig/config/config_error.h"
+#include "rig/config/yaml_fields.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // libFuzzer harness: the Modbus protocol engine the rig's slave answers with
-// (rig/modbus_protocol.h): serve_request() on any PDU, the RTU request
+// (rig/wire/modbus_protocol.h): serve_request() on any PDU, the RTU request
 // assembler on any bytes and silences, the MBAP header check.
 // Oracles beyond the sanitizers: a response PDU is never empty for a non-empty
 // request and never over 253 bytes; an exception response is exactly
@@ -12,8 +12,8 @@
 #include <span>
 #include <vector>
 
-#include "rig/modbus_protocol.h"
-#include "rig/modbus_register_map.h"
+#include "rig/wire/modbus_protocol.h"
+#include "rig/wire/modbus_register_map.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// libFuzzer harness: the controller's NMEA parser (controller/nmea_parser.h)
+// libFuzzer harness: the controller's NMEA parser (rig/nmea/nmea_parser.h)
 // and `rig nmea decode`'s stream decoder, on any bytes.
 // Oracles beyond the sanitizers: exactly one of sentence and error is set; a
 // decoded sentence holds only values its fields can mean (a latitude within
@@ -11,8 +11,8 @@
 #include <string_view>
 #include <variant>
 
-#include "controller/nmea_decode_tool.h"
-#include "controller/nmea_parser.h"
+#include "harness/nmea_decode_tool.h"
+#include "rig/nmea/nmea_parser.h"
 
 namespace {
 

@@ -1,0 +1,36 @@
+# What `cmake --install` puts into the prefix: the controller SDK (docs/sdk.md).
+#   lib/librig_node.a, lib/librig_idl.a, lib/librig_nmea.a   rig::node, rig::idl, rig::nmea
+#   include/rig/runtime/*.h                                  the runtime's headers
+#   include/rig/nmea/*.h                                     the NMEA parser and encoder
+#   include/rig/idl/*.h                                      generated topic types, msg_traits.h, topics.h
+#   share/rig/idl/*.idl, share/rig/idl/topics.json           the types and the topic table for other languages
+#   share/rig/docs/*.md                                      the controller contract
+#   lib/cmake/rig/rigConfig.cmake (+ version, targets)       find_package(rig)
+#   bin/rig, bin/rig-controller                              the harness and the reference controller (full build)
+include(CMakePackageConfigHelpers)
+
+install(TARGETS rig_runtime rig_idl rig_nmea EXPORT rigTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/runtime/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/runtime
+        FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/nmea/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/nmea
+        FILES_MATCHING PATTERN "*.h")
+install(FILES ${RIG_IDL_GENERATED_HEADERS} ${PROJECT_SOURCE_DIR}/idl/msg_traits.h ${PROJECT_SOURCE_DIR}/idl/topics.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/idl)
+file(GLOB RIG_IDL_FILES ${PROJECT_SOURCE_DIR}/idl/*.idl)
+install(FILES ${RIG_IDL_FILES} ${PROJECT_SOURCE_DIR}/idl/topics.json DESTINATION ${CMAKE_INSTALL_DATADIR}/rig/idl)
+install(FILES ${PROJECT_SOURCE_DIR}/docs/controller-contract.md ${PROJECT_SOURCE_DIR}/docs/sdk.md
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/rig/docs)
+
+install(EXPORT rigTargets NAMESPACE rig:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rigConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/rigConfig.cmake
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/rigConfigVersion.cmake COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/rigConfig.cmake ${PROJECT_BINARY_DIR}/rigConfigVersion.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)
+
+if(TARGET rig AND TARGET rig-controller)
+  install(TARGETS rig rig-controller RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()

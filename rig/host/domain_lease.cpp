@@ -1,0 +1,39 @@
+#include "rig/host/domain_lease.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <stdexcept>
+
+namespace rig {
+
+DomainLease DomainLease::acquire(std::uint32_t first, std::uint32_t last) {
+    // Round-robin from after the last domain this process took: a domain a case
+    // has just left is not reused at once, while the previous controller process
+    // may still be on its way out and discovery still remembers it.
+    static std::atomic<std::uint32_t> next{0};
+    const std::uint32_t span = last - first + 1;
+    const std::uint32_t start = next.fetch_add(1) % span;
+    for (std::uint32_t k = 0; k < span; ++k) {
+        const std::uint32_t domain = first + (start + k) % span;
+        const std::string path = "/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock";
+        const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+        if (fd < 0) continue;
+        if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return DomainLease(domain, fd);
+        ::close(fd);
+    }
+    throw std::runtime_error("no free DDS domain id in [" + std::to_string(first) + ", " + std::to_string(last) +
+                             "]: too many rig runs at once?");
+}
+
+DomainLease::DomainLease(DomainLease&& other) noexcept : domain_id_(other.domain_id_), fd_(other.fd_) {
+    other.fd_ = -1;
+}
+
+DomainLease::~DomainLease() {
+    if (fd_ >= 0) ::close(fd_);  // closing releases the flock
+}
+
+}  // namespace rig

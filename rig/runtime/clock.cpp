@@ -1,0 +1,45 @@
+#include "rig/runtime/clock.h"
+
+#include <cerrno>
+#include <ctime>
+
+namespace rig {
+
+RealtimeClock::RealtimeClock() : start_(std::chrono::steady_clock::now()) {}
+
+TimeNs RealtimeClock::now_ns() const {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_).count();
+}
+
+TimeNs RealtimeClock::sleep_until_ns(TimeNs deadline_ns) const {
+    // clock_nanosleep with TIMER_ABSTIME on CLOCK_MONOTONIC (what steady_clock uses on
+    // Linux): an absolute deadline, restarted after signals without drifting.
+    const auto start_since_epoch =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(start_.time_since_epoch()).count();
+    const TimeNs absolute = start_since_epoch + deadline_ns;
+    timespec ts{};
+    ts.tv_sec = static_cast<time_t>(absolute / 1'000'000'000);
+    ts.tv_nsec = static_cast<long>(absolute % 1'000'000'000);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    }
+    const TimeNs late = now_ns() - deadline_ns;
+    return late > 0 ? late : 0;
+}
+
+void RealtimeClock::restart() { start_ = std::chrono::steady_clock::now(); }
+
+std::chrono::steady_clock::time_point RealtimeClock::steady_time(TimeNs t) const {
+    return start_ + std::chrono::nanoseconds(t);
+}
+
+WallStopwatch::WallStopwatch() : start_(std::chrono::steady_clock::now()) {}
+
+double WallStopwatch::elapsed_s() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+std::chrono::milliseconds WallStopwatch::elapsed() const {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start_);
+}
+
+}  // namespace rig

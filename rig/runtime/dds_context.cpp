@@ -1,0 +1,321 @@
+#include "rig/runtime/dds_context.h"
+
+#include <algorithm>
+
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+#include "rig/runtime/participant_factory.h"
+
+namespace rig {
+
+using eprosima::fastrtps::types::ReturnCode_t;
+
+namespace {
+
+// Reliable + keep-all: lockstep acknowledges a tick only after every sample is in
+// every reader's history, so nothing may be dropped or overwritten. Volatile:
+// endpoints are matched before the first tick (see rig/runtime/lockstep.cpp).
+dds::DataWriterQos project_writer_qos(dds::Publisher& publisher) {
+    dds::DataWriterQos qos = publisher.get_default_datawriter_qos();
+    qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+    qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+    // Readers acknowledge in answer to a heartbeat, and wait_for_acknowledgments
+    // waits for that: the heartbeat period is the floor of every lockstep round.
+    // Fast DDS's default (3 s) would make each tick take seconds; heartbeats are
+    // only sent while samples are unacknowledged, so a short period costs nothing idle.
+    qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200'000);
+    qos.reliable_writer_qos().times.initialHeartbeatDelay = eprosima::fastrtps::Duration_t(0, 1'000'000);
+    qos.reliable_writer_qos().times.nackResponseDelay = eprosima::fastrtps::Duration_t(0, 0);
+    qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
+    qos.data_sharing().off();
+    return qos;
+}
+
+dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber) {
+    dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
+    qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
+    qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+    qos.reliable_reader_qos().times.heartbeatResponseDelay = eprosima::fastrtps::Duration_t(0, 0);
+    qos.data_sharing().off();
+    return qos;
+}
+
+}  // namespace
+
+WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
+    : context_(context), topic_name_(std::move(topic_name)), counts_as_output_(counts_as_output) {
+    writer_ = context_.publisher().create_datawriter(topic, project_writer_qos(context_.publisher()), &listener_,
+                                                     dds::StatusMask::publication_matched());
+    if (writer_ == nullptr) throw std::runtime_error("cannot create DDS writer on topic " + topic_name_);
+    context_.register_writer(this);
+}
+
+WriterBase::~WriterBase() {
+    context_.unregister_writer(this);
+    context_.publisher().delete_datawriter(writer_);
+}
+
+bool WriterBase::write_raw(void* sample) {
+    undelivered_.store(true);
+    if (!writer_->write(sample)) return false;
+    written_.fetch_add(1);
+    if (counts_as_output_) context_.note_published();
+    return true;
+}
+
+bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
+    eprosima::fastrtps::Duration_t limit(static_cast<int32_t>(ns / 1'000'000'000),
+                                         static_cast<uint32_t>(ns % 1'000'000'000));
+    if (writer_->wait_for_acknowledgments(limit) != ReturnCode_t::RETCODE_OK) return false;
+    undelivered_.store(false);
+    return true;
+}
+
+void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.notify_data_arrived(); }
+
+ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
+    : context_(context), topic_name_(std::move(topic_name)), listener_(context) {
+    reader_ = context_.subscriber().create_datareader(
+        topic, project_reader_qos(context_.subscriber()), &listener_,
+        dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
+    if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
+    context_.register_reader(this);
+}
+
+ReaderBase::~ReaderBase() {
+    context_.unregister_reader(this);
+    context_.subscriber().delete_datareader(reader_);
+}
+
+bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
+    eprosima::fastrtps::Duration_t limit(static_cast<int32_t>(ns / 1'000'000'000),
+                                         static_cast<uint32_t>(ns % 1'000'000'000));
+    return reader_->wait_for_unread_message(limit);
+}
+
+namespace {
+
+std::string hex_prefix(const unsigned char* bytes, std::size_t size) {
+    static const char* digits = "0123456789abcdef";
+    std::string hex;
+    for (std::size_t i = 0; i < size; ++i) {
+        hex += digits[bytes[i] >> 4];
+        hex += digits[bytes[i] & 0xf];
+    }
+    return hex;
+}
+
+std::string prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+    return hex_prefix(prefix.value, eprosima::fastrtps::rtps::GuidPrefix_t::size);
+}
+
+}  // namespace
+
+bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
+    dds::SampleInfo info;
+    while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data) {
+            taken_.fetch_add(1);
+            if (writer_prefix != nullptr) {
+                // The publication handle is the writer's GUID: its first 12 bytes are its participant's prefix.
+                unsigned char bytes[eprosima::fastrtps::rtps::GuidPrefix_t::size];
+                for (std::size_t i = 0; i < sizeof bytes; ++i) bytes[i] = info.publication_handle.value[i];
+                *writer_prefix = hex_prefix(bytes, sizeof bytes);
+            }
+            return true;
+        }
+        // Dispose / unregister notifications are not samples; nobody writes them here.
+    }
+    return false;
+}
+
+std::uint64_t ReaderBase::received_count() const {
+    // Read the unread count first: a sample taken in between is then counted in
+    // neither, never twice (the count can only be low, and the waiter re-checks).
+    const std::uint64_t unread = reader_->get_unread_count();
+    return taken_.load() + unread;
+}
+
+// Discovery callbacks arrive on Fast DDS's threads; they only append under a lock.
+class DdsContext::DiscoveryWatch final : public dds::DomainParticipantListener {
+public:
+    void on_participant_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_PARTICIPANT && info.status != Status::CHANGED_QOS_PARTICIPANT) return;
+        std::lock_guard lock(mutex);
+        names[prefix_of(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
+    }
+    void on_subscriber_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_READER && info.status != Status::REMOVED_READER) return;
+        add(prefix_of(info.info.guid().guidPrefix), info.info.topicName().to_string(), info.info.typeName().to_string(),
+            false, info.status == Status::REMOVED_READER);
+    }
+    void on_publisher_discovery(dds::DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+        using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+        if (info.status != Status::DISCOVERED_WRITER && info.status != Status::REMOVED_WRITER) return;
+        add(prefix_of(info.info.guid().guidPrefix), info.info.topicName().to_string(), info.info.typeName().to_string(),
+            true, info.status == Status::REMOVED_WRITER);
+    }
+    void add(std::string prefix, std::string topic, std::string type, bool writer, bool removed) {
+        std::lock_guard lock(mutex);
+        const auto name = names.find(prefix);
+        pending.push_back(DiscoveredEndpoint{name == names.end() ? "?" : name->second, std::move(prefix),
+                                             std::move(topic), std::move(type), writer, removed});
+    }
+
+    mutable std::mutex mutex;
+    std::map<std::string, std::string> names;  // GUID prefix -> participant name
+    std::vector<DiscoveredEndpoint> pending;
+};
+
+DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery)
+    : domain_id_(domain_id) {
+    if (watch_discovery) discovery_ = std::make_unique<DiscoveryWatch>();
+    participant_ = create_loopback_participant(domain_id, participant_name, discovery_.get());
+    guid_prefix_ = prefix_of(participant_->guid().guidPrefix);
+    publisher_ = participant_->create_publisher(participant_->get_default_publisher_qos());
+    subscriber_ = participant_->create_subscriber(participant_->get_default_subscriber_qos());
+    if (publisher_ == nullptr || subscriber_ == nullptr) {
+        delete_participant(participant_);
+        throw std::runtime_error("cannot create DDS publisher/subscriber for " + participant_name);
+    }
+}
+
+DdsContext::~DdsContext() { delete_participant(participant_); }
+
+dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*make_type)()) {
+    if (auto it = topics_.find(name); it != topics_.end()) return it->second;
+    dds::TypeSupport type = make_type();
+    const std::string type_name = type.get_type_name();
+    if (participant_->find_type(type_name).empty()) {
+        if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+            throw std::runtime_error("cannot register DDS type " + type_name);
+        }
+    }
+    dds::Topic* topic = participant_->create_topic(name, type_name, participant_->get_default_topic_qos());
+    if (topic == nullptr) throw std::runtime_error("cannot create DDS topic " + name + " of type " + type_name);
+    topics_.emplace(name, topic);
+    return topic;
+}
+
+std::vector<DiscoveredEndpoint> DdsContext::take_discoveries() {
+    std::vector<DiscoveredEndpoint> taken;
+    if (!discovery_) return taken;
+    std::lock_guard lock(discovery_->mutex);
+    for (DiscoveredEndpoint& endpoint : discovery_->pending) {
+        if (same_process(endpoint.guid_prefix)) continue;  // the rig's own endpoints
+        // A participant's name may have been announced after its first endpoint.
+        if (endpoint.participant == "?") {
+            if (const auto name = discovery_->names.find(endpoint.guid_prefix); name != discovery_->names.end()) {
+                endpoint.participant = name->second;
+            }
+        }
+        taken.push_back(std::move(endpoint));
+    }
+    discovery_->pending.clear();
+    return taken;
+}
+
+bool DdsContext::same_process(const std::string& guid_prefix) const {
+    // Fast DDS prefixes: 2 bytes vendor, 2 bytes host, 4 bytes process, 4 bytes participant.
+    constexpr std::size_t kProcessHexDigits = 16;
+    return guid_prefix.compare(0, kProcessHexDigits, guid_prefix_, 0, kProcessHexDigits) == 0;
+}
+
+std::string DdsContext::participant_name(const std::string& guid_prefix) const {
+    if (guid_prefix == guid_prefix_) return participant_->get_qos().name().to_string();
+    if (!discovery_) return "?";
+    std::lock_guard lock(discovery_->mutex);
+    const auto name = discovery_->names.find(guid_prefix);
+    return name == discovery_->names.end() ? "?" : name->second;
+}
+
+std::map<std::string, std::uint64_t> DdsContext::written_counts() const {
+    std::map<std::string, std::uint64_t> counts;
+    for (WriterBase* writer : writers()) {
+        if (writer->counts_as_output()) counts[writer->topic_name()] += writer->written_count();
+    }
+    return counts;
+}
+
+void DdsContext::notify_data_arrived() {
+    {
+        std::lock_guard lock(arrival_mutex_);
+        ++arrivals_;
+    }
+    arrival_.notify_all();
+}
+
+std::uint64_t DdsContext::arrival_count() {
+    std::lock_guard lock(arrival_mutex_);
+    return arrivals_;
+}
+
+bool DdsContext::wait_for_arrival(std::uint64_t seen, std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock lock(arrival_mutex_);
+    return arrival_.wait_until(lock, deadline, [&] { return arrivals_ != seen; });
+}
+
+std::vector<std::string> DdsContext::wait_received(const std::map<std::string, std::uint64_t>& expected,
+                                                   std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::vector<std::string> short_topics;
+    for (;;) {
+        std::unique_lock lock(arrival_mutex_);
+        const std::uint64_t seen = arrivals_;
+        lock.unlock();
+        short_topics.clear();
+        for (ReaderBase* reader : readers()) {
+            const auto it = expected.find(reader->topic_name());
+            if (it != expected.end() && reader->received_count() < it->second) short_topics.push_back(it->first);
+        }
+        if (short_topics.empty()) return short_topics;
+        lock.lock();
+        // Sleep until the next arrival (or the deadline); arrivals since `seen` wake us at once.
+        if (!arrival_.wait_until(lock, deadline, [&] { return arrivals_ != seen; })) return short_topics;
+    }
+}
+
+std::vector<std::string> DdsContext::wait_all_delivered(std::chrono::milliseconds timeout) {
+    std::vector<std::string> late;
+    // A writer that wrote nothing since its last acknowledged sample has nothing to
+    // wait for; skipping it spares a round through Fast DDS per writer per instant.
+    for (WriterBase* writer : writers()) {
+        if (writer->has_undelivered() && !writer->wait_delivered(timeout)) late.push_back(writer->topic_name());
+    }
+    return late;
+}
+
+void DdsContext::register_writer(WriterBase* writer) {
+    std::lock_guard lock(registry_mutex_);
+    writers_.push_back(writer);
+}
+void DdsContext::unregister_writer(WriterBase* writer) {
+    std::lock_guard lock(registry_mutex_);
+    writers_.erase(std::remove(writers_.begin(), writers_.end(), writer), writers_.end());
+}
+void DdsContext::register_reader(ReaderBase* reader) {
+    std::lock_guard lock(registry_mutex_);
+    readers_.push_back(reader);
+}
+void DdsContext::unregister_reader(ReaderBase* reader) {
+    std::lock_guard lock(registry_mutex_);
+    readers_.erase(std::remove(readers_.begin(), readers_.end(), reader), readers_.end());
+}
+std::vector<WriterBase*> DdsContext::writers() const {
+    std::lock_guard lock(registry_mutex_);
+    return writers_;
+}
+std::vector<ReaderBase*> DdsContext::readers() const {
+    std::lock_guard lock(registry_mutex_);
+    return readers_;
+}
+
+}  // namespace rig

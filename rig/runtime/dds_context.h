@@ -1,0 +1,249 @@
+#pragma once
+// One process's DDS entities: a participant from the loopback profile, one
+// publisher, one subscriber, and typed Writer<Msg> / Reader<Msg> endpoints whose
+// QoS the whole project shares (reliable, keep-all, volatile): lockstep time
+// needs every sample delivered before a tick is acknowledged.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "msg_traits.h"
+
+namespace rig {
+
+namespace dds = eprosima::fastdds::dds;
+
+class DdsContext;
+
+// An endpoint of another participant on the domain, as discovery reported it
+// (rig/runtime/dds_context.cpp). The harness judges roles from these, not from what a
+// node says about itself in its hello.
+struct DiscoveredEndpoint {
+    std::string participant;  // the name the participant announced ("?" if its announcement came later)
+    std::string guid_prefix;  // the participant's GUID prefix in hex: two participants of one name differ here
+    std::string topic;
+    std::string type;
+    bool writer = false;      // false: a reader
+    bool removed = false;     // the endpoint went away
+};
+
+// Endpoint-independent part of a writer, so the context can wait for all of them.
+class WriterBase {
+public:
+    virtual ~WriterBase();
+    WriterBase(const WriterBase&) = delete;
+    WriterBase& operator=(const WriterBase&) = delete;
+
+    const std::string& topic_name() const { return topic_name_; }
+    int matched_readers() const { return listener_.matched.load(); }
+    // Blocks until every reader matched now has acknowledged every sample written.
+    bool wait_delivered(std::chrono::milliseconds timeout);
+    // Written to since the last successful wait_delivered() (only those need waiting for).
+    bool has_undelivered() const { return undelivered_.load(); }
+    // Samples written since the writer was created.
+    std::uint64_t written_count() const { return written_.load(); }
+    bool counts_as_output() const { return counts_as_output_; }
+
+protected:
+    WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output);
+    bool write_raw(void* sample);
+
+private:
+    struct MatchListener : dds::DataWriterListener {
+        std::atomic<int> matched{0};
+        void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override {
+            matched.store(status.current_count);
+        }
+    };
+    DdsContext& context_;
+    std::string topic_name_;
+    MatchListener listener_;
+    dds::DataWriter* writer_ = nullptr;
+    bool counts_as_output_;
+    std::atomic<bool> undelivered_{false};
+    std::atomic<std::uint64_t> written_{0};
+};
+
+// A typed writer on one topic. Each publish() is counted by the context, which is
+// how lockstep knows a node produced output during a tick.
+template <class Msg>
+class Writer final : public WriterBase {
+public:
+    Writer(DdsContext& context, const std::string& topic_name, bool counts_as_output = true);
+    void publish(const Msg& sample) {
+        if (!write_raw(const_cast<Msg*>(&sample))) {
+            throw std::runtime_error("DDS write failed on topic " + topic_name());
+        }
+    }
+};
+
+class ReaderBase {
+public:
+    virtual ~ReaderBase();
+    ReaderBase(const ReaderBase&) = delete;
+    ReaderBase& operator=(const ReaderBase&) = delete;
+
+    const std::string& topic_name() const { return topic_name_; }
+    int matched_writers() const { return listener_.matched.load(); }
+    bool has_unread() const { return reader_->get_unread_count() > 0; }
+    // Samples that have arrived since the reader was created (taken or not).
+    std::uint64_t received_count() const;
+    // Blocks (wall time) until a sample is available or the timeout passes.
+    bool wait_for_data(std::chrono::milliseconds timeout);
+
+protected:
+    ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic);
+    // Takes one sample into `sample`; false when the history is empty. With
+    // `writer_prefix`, also says whose participant wrote it (hex GUID prefix).
+    bool take_raw(void* sample, std::string* writer_prefix = nullptr);
+
+private:
+    struct MatchListener : dds::DataReaderListener {
+        explicit MatchListener(DdsContext& owner) : context(owner) {}
+        DdsContext& context;
+        std::atomic<int> matched{0};
+        void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+            matched.store(status.current_count);
+        }
+        void on_data_available(dds::DataReader*) override;
+    };
+    DdsContext& context_;
+    std::string topic_name_;
+    MatchListener listener_;
+    dds::DataReader* reader_ = nullptr;
+    std::atomic<std::uint64_t> taken_{0};
+};
+
+// A typed reader: take_all() returns every received sample in arrival order
+// (per-writer order is preserved by reliable DDS).
+template <class Msg>
+class Reader final : public ReaderBase {
+public:
+    Reader(DdsContext& context, const std::string& topic_name);
+    std::vector<Msg> take_all() {
+        std::vector<Msg> samples;
+        Msg sample;
+        while (take_raw(&sample)) samples.push_back(sample);
+        return samples;
+    }
+    // The same, each with the GUID prefix (hex) of the participant that wrote it.
+    std::vector<std::pair<Msg, std::string>> take_all_with_writer() {
+        std::vector<std::pair<Msg, std::string>> samples;
+        Msg sample;
+        std::string writer;
+        while (take_raw(&sample, &writer)) samples.emplace_back(sample, writer);
+        return samples;
+    }
+};
+
+class DdsContext {
+public:
+    // `watch_discovery`: keep every endpoint other participants create or remove
+    // on the domain, for take_discoveries() (the harness's role check).
+    DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery = false);
+    ~DdsContext();
+    DdsContext(const DdsContext&) = delete;
+    DdsContext& operator=(const DdsContext&) = delete;
+
+    std::uint32_t domain_id() const { return domain_id_; }
+    // This participant's GUID prefix (hex), as Reader::take_all_with_writer reports writers.
+    const std::string& guid_prefix() const { return guid_prefix_; }
+    // Whether a participant's GUID prefix is of this process (its first 8 bytes,
+    // vendor, host and process, are ours): the rig's own participants, whichever
+    // case or domain they serve, never count as a controller's.
+    bool same_process(const std::string& guid_prefix) const;
+    // Endpoints of participants of other processes discovered or removed since the
+    // last call, in the order discovery reported them (empty unless watch_discovery).
+    std::vector<DiscoveredEndpoint> take_discoveries();
+    // The name a participant announced, by GUID prefix ("?" when unknown).
+    std::string participant_name(const std::string& guid_prefix) const;
+    dds::DomainParticipant& participant() { return *participant_; }
+    dds::Publisher& publisher() { return *publisher_; }
+    dds::Subscriber& subscriber() { return *subscriber_; }
+
+    template <class Msg>
+    dds::Topic* topic(const std::string& name) {
+        using PubSub = typename MsgTraits<Msg>::PubSubType;
+        return topic_for(name, [] { return dds::TypeSupport(new PubSub()); });
+    }
+
+    // Samples published (by writers that count as output) since the last call.
+    std::uint32_t take_published_count() { return published_count_.exchange(0); }
+    void note_published() { published_count_.fetch_add(1); }
+
+    // Per topic, the samples this process's output writers have written so far
+    // (the lockstep clock's own writers do not count).
+    std::map<std::string, std::uint64_t> written_counts() const;
+    // Waits until every reader of a topic in `expected` has received at least that
+    // many samples on it (counted delivery, rig/runtime/lockstep.h). Returns the topics
+    // still short when the timeout passes (empty = all there).
+    std::vector<std::string> wait_received(const std::map<std::string, std::uint64_t>& expected,
+                                           std::chrono::milliseconds timeout);
+    // Called by readers when data arrives (wakes wait_received and
+    // wait_for_arrival); anything else that brings input (a Modbus master's write)
+    // may call it too.
+    void notify_data_arrived();
+    // How many arrivals so far; wait_for_arrival returns once it differs from `seen`.
+    std::uint64_t arrival_count();
+    // Blocks until an arrival after `seen` or the deadline; true on an arrival.
+    bool wait_for_arrival(std::uint64_t seen, std::chrono::steady_clock::time_point deadline);
+
+    // Waits until every writer's samples are acknowledged by all matched readers.
+    // Returns the topics that did not make it in time (empty = all delivered).
+    std::vector<std::string> wait_all_delivered(std::chrono::milliseconds timeout);
+
+    // Registry used by wait_all_delivered and endpoint-matching checks.
+    void register_writer(WriterBase* writer);
+    void unregister_writer(WriterBase* writer);
+    void register_reader(ReaderBase* reader);
+    void unregister_reader(ReaderBase* reader);
+    std::vector<WriterBase*> writers() const;
+    std::vector<ReaderBase*> readers() const;
+
+private:
+    dds::Topic* topic_for(const std::string& name, dds::TypeSupport (*make_type)());
+
+    class DiscoveryWatch;
+    std::uint32_t domain_id_;
+    std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
+    std::string guid_prefix_;
+    dds::DomainParticipant* participant_ = nullptr;
+    dds::Publisher* publisher_ = nullptr;
+    dds::Subscriber* subscriber_ = nullptr;
+    std::map<std::string, dds::Topic*> topics_;
+    std::atomic<std::uint32_t> published_count_{0};
+    mutable std::mutex registry_mutex_;
+    std::vector<WriterBase*> writers_;
+    std::vector<ReaderBase*> readers_;
+    std::mutex arrival_mutex_;
+    std::condition_variable arrival_;
+    std::uint64_t arrivals_ = 0;
+};
+
+template <class Msg>
+Writer<Msg>::Writer(DdsContext& context, const std::string& topic_name, bool counts_as_output)
+    : WriterBase(context, topic_name, context.topic<Msg>(topic_name), counts_as_output) {}
+
+template <class Msg>
+Reader<Msg>::Reader(DdsContext& context, const std::string& topic_name)
+    : ReaderBase(context, topic_name, context.topic<Msg>(topic_name)) {}
+
+}  // namespace rig

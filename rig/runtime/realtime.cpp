@@ -1,0 +1,207 @@
+#include "rig/runtime/realtime.h"
+
+#include <sched.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+
+namespace rig {
+
+namespace {
+
+constexpr std::chrono::milliseconds kLivenessSlice{50};
+
+}  // namespace
+
+JitterStats summarize_lateness(std::vector<TimeNs> late_ns) {
+    JitterStats stats;
+    stats.samples = late_ns.size();
+    if (late_ns.empty()) return stats;
+    std::sort(late_ns.begin(), late_ns.end());
+    auto rank = [&](double fraction) {
+        const auto index = static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(late_ns.size()))) - 1;
+        return static_cast<double>(late_ns[std::min(index, late_ns.size() - 1)]) * 1e-6;
+    };
+    stats.p50_ms = rank(0.50);
+    stats.p99_ms = rank(0.99);
+    stats.max_ms = static_cast<double>(late_ns.back()) * 1e-6;
+    return stats;
+}
+
+SchedulingReport request_realtime_scheduling(int priority) {
+    SchedulingReport report;
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+    sched_param param{};
+    param.sched_priority = priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &param) == 0) {
+        report.fifo = true;
+        report.priority = priority;
+        report.detail = "SCHED_FIFO " + std::to_string(priority);
+    } else {
+        report.detail = std::string("SCHED_OTHER (SCHED_FIFO refused: ") + std::strerror(errno) + ")";
+    }
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+        report.memory_locked = true;
+        report.detail += ", memory locked";
+    } else {
+        report.detail += std::string(", memory not locked (") + std::strerror(errno) + ")";
+    }
+    return report;
+}
+
+RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), remotes_(dds, timeouts) {}
+
+RealtimeMaster::~RealtimeMaster() { shutdown(); }
+
+void RealtimeMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0, {}, {}}); }
+
+void RealtimeMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
+    remotes_.add_remote_node(name, std::move(liveness));
+}
+
+void RealtimeMaster::start() {
+    for (Local& local : locals_) local.node->configure(dds_);
+    // Hello and endpoint matching exactly as in lockstep (the remotes' master has
+    // no local nodes of its own: ours are configured above, so their writers are
+    // among those it waits for).
+    remotes_.start();
+    clock_.restart();
+    remotes_.tick_remotes_at(0);  // every remote starts its clock now
+    for (Local& local : locals_) local.node->activate(0);
+    started_ = true;
+}
+
+void RealtimeMaster::run_until(TimeNs end_ns) {
+    if (!started_) throw std::logic_error("RealtimeMaster::run_until before start");
+    for (;;) {
+        const std::uint64_t arrivals_seen = dds_.arrival_count();
+        const TimeNs now = clock_.now_ns();
+        if (now >= end_ns) return;
+        for (Local& local : locals_) {
+            if (local.next_wake_ns <= now) {
+                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
+                if (local.next_wake_ns > 0) local.late_ns.push_back(now - local.next_wake_ns);
+                const TimeNs step_started_ns = clock_.now_ns();
+                local.next_wake_ns = local.node->step(now);
+                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
+            } else if (local.node->has_unread_input()) {
+                const TimeNs step_started_ns = clock_.now_ns();
+                local.next_wake_ns = std::min(local.next_wake_ns, local.node->step(now));
+                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
+            }
+        }
+        if (after_step_) after_step_(now);
+        remotes_.check_remotes_alive(now);
+        if (watchdog_) watchdog_();
+
+        TimeNs next = end_ns;
+        bool input_pending = false;
+        for (const Local& local : locals_) {
+            next = std::min(next, local.next_wake_ns);
+            input_pending |= local.node->has_unread_input();
+        }
+        if (input_pending) continue;
+        // Sleep to the earliest deadline, but no longer than a liveness slice,
+        // and wake at once when input arrives.
+        const TimeNs wake = std::min(next, clock_.now_ns() + std::chrono::nanoseconds(kLivenessSlice).count());
+        dds_.wait_for_arrival(arrivals_seen, clock_.steady_time(wake));
+    }
+}
+
+void RealtimeMaster::shutdown(bool after_failure) noexcept {
+    if (shut_down_) return;
+    shut_down_ = true;
+    remotes_.shutdown(after_failure);  // the shutdown tick; it has no local nodes to stop
+    for (auto it = locals_.rbegin(); it != locals_.rend(); ++it) {
+        try {
+            it->node->shutdown();
+        } catch (const std::exception& error) {
+            std::cerr << "rig: shutting down node '" << it->node->name() << "': " << error.what() << "\n";
+        }
+    }
+}
+
+std::map<std::string, JitterStats> RealtimeMaster::emission_jitter() const {
+    std::map<std::string, JitterStats> jitter;
+    for (const Local& local : locals_) {
+        JitterStats stats = summarize_lateness(local.late_ns);
+        const JitterStats steps = summarize_lateness(local.step_ns);
+        stats.step_p99_ms = steps.p99_ms;
+        stats.step_max_ms = steps.max_ms;
+        jitter[local.node->name()] = stats;
+    }
+    return jitter;
+}
+
+int run_realtime_follower(Node& node, DdsContext& dds, const FollowerOptions& options) {
+    auto started = start_follower(node, dds, options);
+    if (const int* exit_code = std::get_if<int>(&started)) return *exit_code;
+    const std::unique_ptr<FollowerLink> link = std::move(std::get<std::unique_ptr<FollowerLink>>(started));
+
+    // Until the start tick, only hellos are answered.
+    const WallStopwatch waiting;
+    std::optional<msg::ClockTick> start;
+    while (!(start = link->next_tick(kLivenessSlice))) {
+        if (waiting.elapsed() > options.idle_timeout) {
+            std::cerr << options.node_name << ": no start from the harness for " << options.idle_timeout.count()
+                      << " ms; exiting\n";
+            return 4;
+        }
+    }
+    if (start->shutdown()) {
+        link->final_ack(start->seq(), "");
+        return 0;
+    }
+    if (const std::string problem = link->wait_writers_reach_readers(*start); !problem.empty()) {
+        link->final_ack(start->seq(), problem);
+        std::cerr << options.node_name << ": " << problem << "\n";
+        return 3;
+    }
+    RealtimeClock clock;
+    TimeNs next_wake = 0;
+    try {
+        node.activate(0);
+        next_wake = node.step(clock.now_ns());
+    } catch (const std::exception& error) {
+        link->final_ack(start->seq(), error.what());
+        std::cerr << options.node_name << ": " << error.what() << "\n";
+        return 2;
+    }
+    link->ack(start->seq(), next_wake, 0, "", "");
+
+    WallStopwatch harness_missing;
+    for (;;) {
+        const std::uint64_t arrivals_seen = dds.arrival_count();
+        if (const std::optional<msg::ClockTick> tick = link->next_tick(std::chrono::milliseconds(0))) {
+            if (tick->shutdown()) {
+                node.shutdown();
+                link->final_ack(tick->seq(), "");
+                return 0;
+            }
+            link->ack(tick->seq(), next_wake, 0, "", "");
+        }
+        const TimeNs now = clock.now_ns();
+        try {
+            if (next_wake <= now || node.has_unread_input()) next_wake = node.step(now);
+        } catch (const std::exception& error) {
+            std::cerr << options.node_name << ": " << error.what() << "\n";
+            return 2;
+        }
+        if (link->harness_present()) {
+            harness_missing = WallStopwatch();
+        } else if (harness_missing.elapsed() > options.idle_timeout) {
+            std::cerr << options.node_name << ": the harness is gone; exiting\n";
+            return 4;
+        }
+        if (node.has_unread_input()) continue;
+        const TimeNs wake = std::min(next_wake, clock.now_ns() + std::chrono::nanoseconds(kLivenessSlice).count());
+        dds.wait_for_arrival(arrivals_seen, clock.steady_time(wake));
+    }
+}
+
+}  // namespace rig

@@ -1,0 +1,112 @@
+#pragma once
+// Real-time runs (DESIGN.md "Time", issue: bench acceptance): every node on the
+// wall clock with absolute deadlines, for a controller board on real wires or a
+// controller process that keeps its own time.
+//
+// Master side (RealtimeMaster, in the harness): local nodes (plant, emulators,
+// wire adapters) run at their own wake times on one RealtimeClock. A node is
+// stepped with the instant it actually runs, so truth is evaluated when each
+// sample is emitted and scheduling jitter does not become metric error; how
+// late each node woke against its deadline is recorded per node (emission
+// jitter). Nodes with unread input run at once (input arrival wakes the loop).
+// Remote nodes (the controller process) keep their own clocks: the master says
+// hello as in lockstep, then one tick at t = 0 starts every clock, and the
+// shutdown tick ends the run. A remote whose process ends fails the run by name.
+//
+// Follower side (run_realtime_follower, in the controller process): the same
+// Node interface, stepped on its own RealtimeClock from the start tick on.
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/lockstep.h"
+#include "rig/runtime/node.h"
+
+namespace rig {
+
+// Lateness of wake-ups against their deadlines, in milliseconds.
+struct JitterStats {
+    std::size_t samples = 0;
+    double p50_ms = 0.0;
+    double p99_ms = 0.0;
+    double max_ms = 0.0;
+    // How long the node's own steps took: a long step makes every node after
+    // it in the loop late, so this says whose update a lateness came from.
+    double step_p99_ms = 0.0;
+    double step_max_ms = 0.0;
+};
+// Nearest-rank percentiles of `late_ns` (all >= 0); zeros when empty.
+JitterStats summarize_lateness(std::vector<TimeNs> late_ns);
+
+// What the process got when it asked for real-time scheduling.
+struct SchedulingReport {
+    bool fifo = false;          // SCHED_FIFO for the calling thread
+    int priority = 0;
+    bool memory_locked = false; // mlockall(MCL_CURRENT | MCL_FUTURE)
+    std::string detail;         // e.g. "SCHED_FIFO 40, memory locked" or why not
+};
+// Asks for SCHED_FIFO at `priority` for the calling thread and locks memory;
+// whatever is refused (no CAP_SYS_NICE, RLIMIT_MEMLOCK) is said in `detail`,
+// and the run goes on without it. Also sets the timer slack to 1 ns, so
+// deadline waits are not rounded up by the kernel's default 50 us.
+SchedulingReport request_realtime_scheduling(int priority);
+
+class RealtimeMaster {
+public:
+    RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts);
+    ~RealtimeMaster();
+
+    void add_local_node(Node& node);
+    void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
+    // Called after every pass through the loop with the instant it began (the
+    // trace recorder drains its readers here).
+    void set_after_step(std::function<void(TimeNs)> callback) { after_step_ = std::move(callback); }
+    // As LockstepMaster::set_watchdog: called while waiting at start-up and after every pass.
+    void set_watchdog(std::function<void()> callback) {
+        watchdog_ = callback;
+        remotes_.set_watchdog(std::move(callback));
+    }
+
+    // Configures the local nodes, says hello to the remotes, waits for every
+    // endpoint to match, then starts every clock at t = 0.
+    void start();
+    // Runs until the clock reaches end_ns. Throws NodeFailure for a remote that
+    // died and whatever a local node's step throws.
+    void run_until(TimeNs end_ns);
+    // The shutdown tick to the remotes, local nodes shut down in reverse order.
+    // Never throws. `after_failure`: as LockstepMaster::shutdown.
+    void shutdown(bool after_failure = false) noexcept;
+
+    const RealtimeClock& clock() const { return clock_; }
+    // Per local node (by name): how late its timed wake-ups were.
+    std::map<std::string, JitterStats> emission_jitter() const;
+
+private:
+    struct Local {
+        Node* node;
+        TimeNs next_wake_ns = 0;
+        std::vector<TimeNs> late_ns;
+        std::vector<TimeNs> step_ns;
+    };
+    DdsContext& dds_;
+    LockstepMaster remotes_;
+    RealtimeClock clock_;
+    std::vector<Local> locals_;
+    std::function<void(TimeNs)> after_step_;
+    std::function<void()> watchdog_;
+    bool started_ = false;
+    bool shut_down_ = false;
+};
+
+// Runs `node` in this process on its own wall clock, from the master's start
+// tick to its shutdown tick. Returns a process exit code (0 = clean shutdown) and
+// prints the reason for any other to stderr.
+int run_realtime_follower(Node& node, DdsContext& dds, const FollowerOptions& options);
+
+}  // namespace rig

@@ -1,0 +1,145 @@
+#pragma once
+// The rig's side of the bench wires (issue: plug in a real controller). Which
+// wire each device uses is chosen in the case file (`wiring:`), like
+// ros2_control's real-or-mock hardware: the emulators always publish their
+// device topics and the plant always takes actuator topics; an adapter node here
+// carries them over the chosen wire, so neither side changes for it.
+//
+//   NmeaSerialAdapter   device/gnss/nmea  ->  a serial port (the G970II's RS232 line)
+//   BoardIoAdapter      device topics     ->  the board's inputs  (io::DeviceSignals)
+//                       actuator topics   <-  the board's outputs (io::ActuatorCommands)
+//                       controller/breakpoint_event <- the board's indicator counters
+//     through a BoardIoWire: the Modbus slave (TCP or RTU, docs/modbus-register-map.md)
+//     or the USB-HID I/O board (docs/hid-io-board.md).
+//
+// Adapters run in real time only: a wire has no virtual time.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "rig/runtime/actuator_topics.h"
+#include "rig/runtime/board_input_topics.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/wire/hid_board.h"
+#include "rig/runtime/io_image.h"
+#include "rig/wire/modbus_slave.h"
+#include "rig/runtime/node.h"
+#include "rig/wire/serial_port.h"
+
+namespace rig {
+
+// Writes every NMEA sentence published on device/gnss/nmea to a serial port,
+// byte for byte, as the receiver would.
+//   Subscriptions: device/gnss/nmea
+class NmeaSerialAdapter final : public Node {
+public:
+    explicit NmeaSerialAdapter(SerialPort& port);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override;
+    std::uint64_t sentences_written() const { return sentences_written_; }
+
+private:
+    std::string name_ = "nmea_serial";
+    SerialPort& port_;
+    std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
+    std::uint64_t sentences_written_ = 0;
+};
+
+// One board-I/O wire, as the adapter sees it.
+class BoardIoWire {
+public:
+    virtual ~BoardIoWire() = default;
+    virtual std::string description() const = 0;
+    // Puts the board's inputs on the wire; `spread_ns` is how long until the next
+    // update (a pulse output spreads the new pulses over it).
+    virtual void put_inputs(const io::DeviceSignals& signals, TimeNs spread_ns) = 0;
+    // The board's outputs as the wire has them now.
+    virtual io::ActuatorCommands outputs() = 0;
+    virtual io::ControllerIndicators indicators() = 0;
+    // Something new on the wire since the last call (the adapter then runs at once).
+    virtual bool changed() = 0;
+};
+
+// The rig as Modbus slave: the board (master) reads the inputs and writes its outputs.
+class ModbusSlaveWire final : public BoardIoWire {
+public:
+    // Serve the register map on TCP (127.0.0.1 unless the options allow more) or RTU.
+    explicit ModbusSlaveWire(const modbus::TcpSlaveOptions& options);
+    explicit ModbusSlaveWire(const modbus::RtuSlaveOptions& options);
+    // Called from the slave's thread whenever the master writes (wakes the run loop).
+    void set_wake(std::function<void()> wake);
+    std::string description() const override;
+    void put_inputs(const io::DeviceSignals& signals, TimeNs spread_ns) override;
+    io::ActuatorCommands outputs() override;
+    io::ControllerIndicators indicators() override;
+    bool changed() override;
+    modbus::ModbusSlave& slave() { return *slave_; }
+
+private:
+    // Shared with the slave's callback, which may run until the slave is stopped.
+    struct WriteSignal {
+        std::mutex mutex;
+        std::function<void()> wake;
+    };
+    modbus::ModbusSlaveCallbacks callbacks();
+    std::shared_ptr<WriteSignal> signal_ = std::make_shared<WriteSignal>();
+    std::unique_ptr<modbus::ModbusSlave> slave_;
+    std::uint64_t writes_seen_ = 0;
+};
+
+// The USB-HID bench I/O board: pulse outputs, relay-sensing inputs.
+class HidBoardWire final : public BoardIoWire {
+public:
+    explicit HidBoardWire(std::unique_ptr<HidBoard> board, std::string description);
+    std::string description() const override { return description_; }
+    void put_inputs(const io::DeviceSignals& signals, TimeNs spread_ns) override;
+    io::ActuatorCommands outputs() override;
+    io::ControllerIndicators indicators() override;
+    bool changed() override { return false; }  // polled at every input update
+
+private:
+    std::unique_ptr<HidBoard> board_;
+    std::string description_;
+    io::ActuatorCommands latest_{};
+};
+
+// Device topics onto a board-I/O wire, and the board's outputs back as actuator
+// topics (and its breakpoint counters as events), at update_rate_hz and whenever
+// the wire reports a change.
+//   Subscriptions: device/wheel_encoder/count, device/main_flow_meter/count,
+//                  device/pump_flow_sensor/voltage, device/boom_height_sensor/voltage,
+//                  device/breakpoint_button/level, device/spray_switch/level
+//   Publications:  actuator/ball_valve/relays, actuator/section_valves/open,
+//                  actuator/unloading_valve/open, controller/breakpoint_event
+class BoardIoAdapter final : public Node {
+public:
+    BoardIoAdapter(BoardIoWire& wire, double update_rate_hz);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override;
+
+private:
+    void take_device_topics();
+    void publish_outputs(TimeNs now_ns);
+
+    std::string name_ = "board_io";
+    BoardIoWire& wire_;
+    TimeNs period_ns_;
+    TimeNs next_update_ns_ = 0;
+    io::DeviceSignals signals_{};
+    io::ControllerIndicators seen_indicators_{};
+    // --- subscriptions
+    std::unique_ptr<BoardInputReaders> device_inputs_;  // encoder, flow meter, sensors, button, switch
+    // --- publications
+    std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
+    std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
+};
+
+}  // namespace rig
