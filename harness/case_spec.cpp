@@ -2,7 +2,7 @@
 
 #include "emulators/land_wheel.h"
 #include "rig/file_access.h"
-#include "rig/lockstep.h"
+#include "rig/failure_kind.h"
 #include "rig/modbus_protocol.h"
 
 #include <algorithm>
