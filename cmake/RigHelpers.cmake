@@ -52,7 +52,6 @@ function(rig_add_test name)
   target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE
     RIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    RIG_SHARED_DIR="${PROJECT_SOURCE_DIR}/../shared"
     RIG_BINARY_DIR="${PROJECT_BINARY_DIR}")
   add_test(NAME ${name} COMMAND ${name})
   set_tests_properties(${name} PROPERTIES TIMEOUT 600)

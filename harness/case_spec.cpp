@@ -2,7 +2,7 @@
 
 #include "emulators/land_wheel.h"
 #include "rig/config/file_access.h"
-#include "rig/runtime/lockstep.h"
+#include "rig/runtime/failure_kind.h"
 #include "rig/wire/modbus_protocol.h"
 
 #include <algorithm>

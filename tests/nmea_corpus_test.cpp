@@ -1,5 +1,5 @@
 // Regression test of the NMEA parser against gpsd 3.22's decoding of ten real
-// receiver logs (${RIG_SHARED_DIR}/corpora/gpsd-nmea, see its README.md).
+// receiver logs (tests/data/gpsd-nmea, with gpsd's licence; see its README.md).
 //
 // How X.log.chk relates to X.log (worked out from the files):
 //  - The .chk is gpsd's output in log order: every sentence gpsd's packet layer
@@ -75,7 +75,7 @@ constexpr double kPositionToleranceDeg = 0.5e-9 + 1e-12;
 constexpr double kTimeToleranceS = 0.5e-3 + 1e-9;
 constexpr long kDaysPerGpsWeekRollover = 1024 * 7;
 
-fs::path corpus_dir() { return fs::path(RIG_SHARED_DIR) / "corpora" / "gpsd-nmea"; }
+fs::path corpus_dir() { return fs::path(RIG_SOURCE_DIR) / "tests" / "data" / "gpsd-nmea"; }
 
 std::vector<std::string> corpus_logs() {
     std::vector<std::string> names;

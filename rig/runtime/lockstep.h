@@ -44,31 +44,10 @@
 
 #include "rig/runtime/clock.h"
 #include "rig/runtime/dds_context.h"
+#include "rig/runtime/failure_kind.h"
 #include "rig/runtime/node.h"
 
 namespace rig {
-
-// Why a run could not go on. The names are part of the results contract
-// (results.json `error_kind`, a case's `expect: { error: ... }`), so a case can
-// say which failure a faulty controller must cause.
-enum class FailureKind {
-    node_exited,           // the node's process ended (crash, exit) before the run did
-    node_unresponsive,     // it did not acknowledge a tick within the bound
-    node_fatal_error,      // it reported a fatal error in its acknowledgement
-    startup_timeout,       // discovery, hello or endpoint matching not done in time
-    delivery_timeout,      // samples it published did not arrive in time
-    topic_role_violation,  // a process read or wrote a topic its role forbids (truth, device, clock)
-    wire_unread,           // a bench wire's far end never took what the rig wrote on it
-    wall_time_exceeded,    // the case ran past its wall-time bound
-    feedback_loop,         // nodes kept answering each other at one instant
-    interrupted,           // SIGINT / SIGTERM stopped the run
-    harness_error,         // the rig itself failed (a trace it cannot write, a bad wire...)
-};
-std::string_view to_string(FailureKind kind);
-// The kind with this name; nullopt for an unknown one.
-std::optional<FailureKind> failure_kind_from_string(std::string_view name);
-// Every kind, for validation messages ("one of: ...").
-std::string failure_kind_names();
 
 // A node failed: did not answer in time, died, or reported a fatal error.
 class NodeFailure : public std::runtime_error {
