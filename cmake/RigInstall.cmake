@@ -24,9 +24,11 @@ install(FILES ${PROJECT_SOURCE_DIR}/docs/controller-contract.md ${PROJECT_SOURCE
         DESTINATION ${CMAKE_INSTALL_DATADIR}/rig/docs)
 
 install(EXPORT rigTargets NAMESPACE rig:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)
+set(RIG_IDL_INSTALL_DIR ${CMAKE_INSTALL_DATADIR}/rig/idl)
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/rigConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/rigConfig.cmake
-                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig
+                              PATH_VARS RIG_IDL_INSTALL_DIR)
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/rigConfigVersion.cmake COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/rigConfig.cmake ${PROJECT_BINARY_DIR}/rigConfigVersion.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/rig)

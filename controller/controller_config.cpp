@@ -184,6 +184,17 @@ ControllerConfig parse_controller_config(const YamlSection& section) {
         section.optional_in_range("status_rate_hz", config.status_rate_hz, Bounds::closed(1.0, 1000.0));
     // The store is the one file the controller writes: a plain name inside its
     // --state-dir (no '/', no '..'), so a case cannot point it at another file.
+    config.diagnostics_topic = section.optional<std::string>("diagnostics_topic", config.diagnostics_topic);
+    if (!config.diagnostics_topic.empty()) {
+        // Its own namespace: never a topic of the contract (docs/controller-contract.md).
+        for (const char* reserved : {"rig/", "device/", "actuator/", "controller/", "truth/"}) {
+            if (config.diagnostics_topic.rfind(reserved, 0) == 0) {
+                section.fail("diagnostics_topic", "must not start with '" + std::string(reserved) +
+                                                      "' (the contract's topics); e.g. reference/phases");
+            }
+        }
+        if (config.diagnostics_topic.size() > 64) section.fail("diagnostics_topic", "is longer than 64 characters");
+    }
     config.breakpoint_store_file = section.optional<std::string>("breakpoint_store_file", config.breakpoint_store_file);
     if (const std::string problem = breakpoint_store_name_problem(config.breakpoint_store_file); !problem.empty()) {
         section.fail("breakpoint_store_file", problem);

@@ -69,6 +69,10 @@ struct ControllerConfig {
     double arm_distance_m = 1.0;           // ...and the nozzle line is at least this far behind it
     double status_rate_hz = 10.0;
     std::string breakpoint_store_file = "breakpoints.txt";  // relative to the state dir
+    // A topic of its own on which it writes a line of text at every change of its
+    // spray phase (for the person reading the trace; the rig records a
+    // controller's own topics without knowing their type). Empty: none.
+    std::string diagnostics_topic;
 
     // ---- Flow control and breakpoint continuation (sec. 2.2.1-2.2.3)
     double target_flow_l_min = 20.0;        // sec. 2.5.2

@@ -24,6 +24,9 @@ void ReferenceController::configure(DdsContext& dds) {
     actuators_writer_ = std::make_unique<ActuatorTopicsWriter>(dds);
     status_writer_ = std::make_unique<Writer<msg::ControllerStatus>>(dds, topics::kControllerStatus);
     event_writer_ = std::make_unique<Writer<msg::BreakpointEvent>>(dds, topics::kBreakpointEvent);
+    if (!config_.diagnostics_topic.empty()) {
+        diagnostics_writer_ = std::make_unique<Writer<msg::NmeaSentence>>(dds, config_.diagnostics_topic);
+    }
 
     // TEST-ONLY faults. A reader made straight on the DDS subscriber, outside the
     // context's registry: the hello does not list it, as a controller that hides
@@ -78,6 +81,12 @@ TimeNs ReferenceController::step(TimeNs now_ns) {
     actuators_writer_->publish_changes(firmware_.actuators());
     for (const msg::BreakpointEvent& event : firmware_.take_events()) event_writer_->publish(event);
     for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
+    if (diagnostics_writer_ && firmware_.phase() != last_phase_) {
+        last_phase_ = firmware_.phase();
+        msg::NmeaSentence line;
+        line.sentence(std::string("phase ") + std::to_string(static_cast<int>(*last_phase_)));
+        diagnostics_writer_->publish(line);
+    }
     if (now_ns >= next_status_ns_) {
         status_writer_->publish(firmware_.status(now_ns));
         next_status_ns_ = next_period_boundary(now_ns, status_period_ns_);

@@ -44,6 +44,8 @@ private:
     std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::ControllerStatus>> status_writer_;
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
+    std::unique_ptr<Writer<msg::NmeaSentence>> diagnostics_writer_;  // config.diagnostics_topic: text lines
+    std::optional<msg::SprayPhase> last_phase_;
     // --- TEST-ONLY faults (ControllerFaults): a topic read behind the hello's
     // back, forged truth written.
     dds::DataReader* undeclared_reader_ = nullptr;

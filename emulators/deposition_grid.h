@@ -2,8 +2,8 @@
 // Spray deposited on the ground (plant truth): a grid of cells along the A-B line
 // (cell_along_m long) by nozzle columns across the boom, one layer per pass, so
 // the first pass up to the breakpoint and the continuation pass each leave their
-// own dose and the harness can tell overlap from missed strips (DESIGN.md "What
-// the harness measures"). A nozzle's flat fan lands as a uniform band
+// own dose and the harness can tell overlap from missed strips (docs/metrics.md).
+// A nozzle's flat fan lands as a uniform band
 // footprint_along_m long centred under the nozzle; what falls outside the grid is
 // counted, not lost silently.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Reproducible random numbers for the device and plant models (DESIGN.md "Time":
+// Reproducible random numbers for the device and plant models (docs/design.md "Time":
 // same case + same seed => identical trace).
 //
 // The engine is std::mt19937_64, whose output sequence the C++ standard fixes

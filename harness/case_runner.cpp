@@ -4,7 +4,9 @@
 #include <atomic>
 #include <csignal>
 #include <cstring>
+#include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "controller/controller_config.h"
@@ -106,6 +108,7 @@ public:
         trace_.file().record_discoveries(now_ns_, found);
         for (const DiscoveredEndpoint& endpoint : found) {
             if (endpoint.removed) continue;
+            if (endpoint.writer) writer_types_[endpoint.topic] = endpoint.type;
             if (const auto why = topic_role_violation(endpoint.writer ? "writer" : "reader", endpoint.topic)) {
                 throw NodeFailure(FailureKind::topic_role_violation, endpoint.participant,
                                   *why + " (GUID prefix " + endpoint.guid_prefix + ", seen by discovery)");
@@ -122,7 +125,14 @@ public:
         }
     }
 
+    // The type another process's writer announced for a topic, once discovery saw it.
+    std::optional<std::string> writer_type(const std::string& topic) const {
+        const auto it = writer_types_.find(topic);
+        return it == writer_types_.end() ? std::nullopt : std::optional<std::string>(it->second);
+    }
+
 private:
+    std::map<std::string, std::string> writer_types_;
     const CaseSpec& spec_;
     const WallStopwatch& wall_;
     DdsContext& dds_;
@@ -130,6 +140,32 @@ private:
     CaseSession& session_;
     const TimeNs& now_ns_;
 };
+
+// Topics the controller said in its hello it writes that the rig has no type
+// for (its own diagnostics): recorded as raw samples, so they are matched,
+// counted and kept like any other. A topic it may not write at all is left to
+// the role check, which fails the case.
+void record_own_topics(const std::vector<std::string>& topics, TraceRecorder& trace, Watchdog& watchdog) {
+    std::set<std::string> unknown;
+    for (const std::string& topic : topics) {
+        if (!trace.records(topic) && topic != topics::kClockAck && !topic_role_violation("writer", topic)) {
+            unknown.insert(topic);
+        }
+    }
+    const WallStopwatch waited;
+    for (const std::string& topic : unknown) {
+        // Discovery tells the type name; it has normally arrived with the hello.
+        while (!watchdog.writer_type(topic)) {
+            if (waited.elapsed() > std::chrono::seconds(10)) {
+                throw NodeFailure(FailureKind::startup_timeout, "controller",
+                                  "its hello lists topic " + topic + ", but no writer of it was discovered within 10 s");
+            }
+            watchdog();
+            RealtimeClock().sleep_until_ns(RealtimeClock().now_ns() + seconds_to_ns(0.005));
+        }
+        trace.record_raw(topic, *watchdog.writer_type(topic));
+    }
+}
 
 LockstepTimeouts timeouts_of(const CaseSpec& spec) {
     LockstepTimeouts timeouts;
@@ -149,6 +185,7 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         trace.drain(t, round);
     });
     master.set_watchdog([&watchdog] { watchdog(); });
+    master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
     try {
         master.start();
         facts.startup_wall_seconds = wall.elapsed_s();
@@ -177,6 +214,7 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         trace.drain(t, 0);
     });
     master.set_watchdog([&watchdog] { watchdog(); });
+    master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
     auto collect_jitter = [&] {
         for (const auto& [device, stats] : master.emission_jitter()) {
             // Nodes that only react to inputs (the NMEA serial adapter, a switch
@@ -284,7 +322,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 
         const CaseWorld world = build_case_world(spec, seed);
         emulators::SprayCircuit circuit(world.plant, world.circuit);
-        CaseSession session(spec, case_dir);
+        CaseSession session(spec, case_dir, options.domain);
         // The harness's participant first, watching discovery; then the
         // controller, so every endpoint it makes is seen.
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);

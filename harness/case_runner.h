@@ -23,6 +23,9 @@ struct RunOptions {
     std::filesystem::path out_dir = "rig-out";
     std::optional<std::uint64_t> seed_override;
     int jobs = 1;
+    // `--domain N`: every case on this DDS domain (one at a time); else a case's
+    // own `domain:`, else a free one.
+    std::optional<std::uint32_t> domain;
     // Default controller when a case names no command: the reference controller.
     std::filesystem::path controller_executable = "rig-controller";
 };

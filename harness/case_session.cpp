@@ -108,8 +108,12 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
 
 
 
-CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir)
-    : wires_(open_bench_wires(spec)), lease_(DomainLease::acquire()), controller_log_(case_dir / "controller.log") {}
+CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
+                         std::optional<std::uint32_t> domain)
+    : wires_(open_bench_wires(spec)),
+      lease_(domain ? DomainLease::acquire_exact(*domain) : spec.domain ? DomainLease::acquire_exact(*spec.domain)
+                                                                         : DomainLease::acquire()),
+      controller_log_(case_dir / "controller.log") {}
 
 void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
                                    const std::filesystem::path& case_dir) {
@@ -118,7 +122,13 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
     if (spec.wiring.external_controller || controller_) return;
     write_controller_config(spec, case_dir / "controller.yaml");
     std::vector<std::string> argv = spec.controller.command;
-    if (argv.empty()) argv.push_back(controller_executable.string());
+    if (argv.empty()) {
+        argv.push_back(controller_executable.string());
+    } else if (argv[0].find('/') != std::string::npos && std::filesystem::path(argv[0]).is_relative()) {
+        // A relative path names a program beside the case file (a bare name is
+        // looked up in PATH), wherever `rig run` is started from.
+        argv[0] = (std::filesystem::absolute(spec.source_path).parent_path() / argv[0]).lexically_normal().string();
+    }
     for (const std::string& arg :
          {std::string("--domain"), std::to_string(lease_.domain_id()), std::string("--node-name"),
           std::string("controller"), std::string("--config"), (case_dir / "controller.yaml").string(),

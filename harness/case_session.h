@@ -39,7 +39,8 @@ class CaseSession {
 public:
     // Opens the wires and takes a DDS domain. Throws std::runtime_error naming
     // what could not be opened.
-    CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir);
+    CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
+                std::optional<std::uint32_t> domain = std::nullopt);
     // Writes the controller's configuration into case_dir and starts the
     // controller with the wires' far ends (unless the case wires an external
     // board). Called once the harness's participant exists on the domain, so

@@ -636,6 +636,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
         }
         spec.seed = spec.seeds.front();
     }
+    if (root.has("domain")) spec.domain = root.required_in_range<std::uint32_t>("domain", Bounds::closed(0, 232));
     spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
     spec.scenario = root.optional_enum<Scenario>("scenario", kScenarios, spec.scenario);
     spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);

@@ -1,5 +1,5 @@
 #pragma once
-// A case file (DESIGN.md "Case files") as plain structs, and its strict loader.
+// A case file (docs/design.md "Case files") as plain structs, and its strict loader.
 // Every mistake in a case file is a rig::ConfigError at `file:line:col: key: message`,
 // raised before anything starts.
 //
@@ -272,6 +272,10 @@ struct CaseSpec {
     SourceLocation name_location;  // where `name` is written (duplicate names are reported there)
     std::string description;
     std::uint64_t seed = 1;  // `rig run --seed` overrides
+    // The DDS domain the case runs on; by default each case takes a free one.
+    // Fixed (or `rig run --domain`), an observer (a Cyclone DDS reader, a
+    // debugger) knows where to look. [0, 232]: Fast DDS's ports end there.
+    std::optional<std::uint32_t> domain;
     // `seeds: [..]` instead of `seed`: the case runs once per seed, as NAME-seedN
     // (a faulty controller must be caught on every one).
     std::vector<std::uint64_t> seeds;
@@ -302,9 +306,8 @@ struct CaseSpec {
     TimeoutsSpec timeouts;
 };
 
-// Limits every case gets unless its file overrides them (DESIGN.md "What the
-// harness measures"), each only where its scenario measures it
-// (default_limit_applies): a limited metric that is not measured fails the case.
+// Limits every case gets unless its file overrides them (docs/metrics.md),
+// each only where its scenario measures it (default_limit_applies): a limited metric that is not measured fails the case.
 inline const std::map<std::string, double> kDefaultLimits = {
     {"breakpoint_error_m", 0.20},  // Table 3: fusion max 15.85 cm; the rig's fusion spread over seeds reaches 19.2 cm
     {"flow_adjust_time_s", 1.7},   // Table 2: longest 1.716 s

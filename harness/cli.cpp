@@ -1,4 +1,4 @@
-// `rig`: the rig's one command line (DESIGN.md "Command line").
+// `rig`: the rig's one command line (README "Running cases", `rig --help`).
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
@@ -124,6 +124,10 @@ int main(int argc, char** argv) {
     auto* seed_option = run->add_option("--seed", seed, "override every case's seed");
     run->add_option("--jobs", run_options.jobs, "cases run at once, each on its own DDS domain")
         ->check(CLI::Range(1, 16));
+    std::uint32_t domain = 0;
+    auto* domain_option =
+        run->add_option("--domain", domain, "run every case on this DDS domain (one case at a time), e.g. for an observer")
+            ->check(CLI::Range(0, 232));
 
     rig::harness::JudgeCommandOptions judge_options;
     auto* judge = app.add_subcommand(
@@ -167,6 +171,13 @@ int main(int argc, char** argv) {
     if (emulate_bench.parsed()) return emulate_bench.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
+        if (domain_option->count() > 0) {
+            if (run_options.jobs > 1) {
+                std::cerr << "rig run: --domain " << domain << " puts every case on one domain: use it with --jobs 1\n";
+                return 2;
+            }
+            run_options.domain = domain;
+        }
         return run_command(case_inputs, run_options);
     }
     if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);

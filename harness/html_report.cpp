@@ -278,7 +278,7 @@ std::string vertical_marker(int tag, double x, std::string_view color, std::stri
     return script;
 }
 
-// The target as a dashed line and its ±3 % band as a pale strip (DESIGN.md: the
+// The target as a dashed line and its ±3 % band as a pale strip (docs/design.md: the
 // adjust time ends when flow enters ±3 % of target and stays there).
 std::string target_band(double target) {
     const std::string low = exact_number(target * 0.97);

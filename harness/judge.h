@@ -99,7 +99,7 @@ struct CaseRun {
 // and expectations, and the figures. Never throws for a trace read_trace accepted.
 CaseRun judge_trace(const RecordedTrace& trace);
 
-// Roles (DESIGN.md "Data flow"): a participant other than the rig's may not
+// Roles (docs/design.md "Data flow"): a participant other than the rig's may not
 // read or write truth/*, nor write device/* or the clock's tick. Returns why an
 // endpoint breaks its role ("reads truth topic truth/vehicle"), or nullopt.
 std::optional<std::string> topic_role_violation(const std::string& endpoint, const std::string& topic);

@@ -1,6 +1,5 @@
 #pragma once
-// Judging metrics against limits, and the run's outputs (DESIGN.md "Results
-// contract"): results.json, junit.xml and the human report / terminal table.
+// Judging metrics against limits, and the run's outputs (docs/design.md "Results"): results.json, junit.xml and the human report / terminal table.
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -114,7 +113,7 @@ RunSummary summarize(const std::vector<CaseResult>& results);
 
 // ------------------------------------------------------------------ outputs
 
-// The DESIGN.md contract: {"cases": [{name, passed, seed, metrics, limits,
+// The docs/design.md contract: {"cases": [{name, passed, seed, metrics, limits,
 // failures, trace_sha256, + file, expected_failure, error (null when none),
 // trace_path, sim_seconds, wall_seconds}], "summary": {passed, failed,
 // sim_seconds, wall_seconds, + total}}. NaN metrics become null; malformed

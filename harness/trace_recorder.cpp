@@ -1,5 +1,9 @@
 #include "harness/trace_recorder.h"
 
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+
 #include "harness/trace_json.h"
 #include "idl/topics.h"
 
@@ -44,6 +48,53 @@ TraceRecorder::TraceRecorder(DdsContext& dds, const std::filesystem::path& file)
     add_channel<msg::UnloadingValve>(dds, topics::kUnloadingValve);
     add_channel<msg::ControllerStatus>(dds, topics::kControllerStatus);
     add_channel<msg::BreakpointEvent>(dds, topics::kBreakpointEvent);
+}
+
+bool TraceRecorder::records(const std::string& topic) const {
+    return std::any_of(channels_.begin(), channels_.end(), [&](const Channel& channel) { return channel.topic == topic; });
+}
+
+void TraceRecorder::record_raw(const std::string& topic, const std::string& type_name) {
+    if (records(topic)) return;
+    // A type the rig knows (a controller reusing, say, NmeaSentence for text):
+    // read and recorded as such. A participant holds one type per name, so
+    // these could not be read as raw bytes anyway.
+    using Adder = void (*)(TraceRecorder&, DdsContext&, const char*);
+    static const std::map<std::string, Adder> known = {
+        {"rig::msg::NmeaSentence", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::NmeaSentence>(d, t); }},
+        {"rig::msg::EncoderCount", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::EncoderCount>(d, t); }},
+        {"rig::msg::FlowMeterCount", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::FlowMeterCount>(d, t); }},
+        {"rig::msg::AnalogInput", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::AnalogInput>(d, t); }},
+        {"rig::msg::SwitchLevel", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::SwitchLevel>(d, t); }},
+        {"rig::msg::BallValveRelays", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::BallValveRelays>(d, t); }},
+        {"rig::msg::SectionValves", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::SectionValves>(d, t); }},
+        {"rig::msg::UnloadingValve", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::UnloadingValve>(d, t); }},
+        {"rig::msg::ControllerStatus", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::ControllerStatus>(d, t); }},
+        {"rig::msg::BreakpointEvent", [](TraceRecorder& r, DdsContext& d, const char* t) { r.add_channel<msg::BreakpointEvent>(d, t); }},
+    };
+    file_.set_meta("own_topic:" + topic, type_name);
+    if (const auto it = known.find(type_name); it != known.end()) {
+        it->second(*this, dds_, topic.c_str());
+        return;
+    }
+    if (!dds_.participant().find_type(type_name).empty()) {
+        throw std::runtime_error("topic " + topic + " has type " + type_name +
+                                 ", a type the rig uses but cannot record for another topic");
+    }
+    auto reader = std::make_shared<RawReader>(dds_, topic, type_name);
+    readers_.push_back(reader);
+    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<nlohmann::json, std::string>>& out) {
+                                    static const char* digits = "0123456789abcdef";
+                                    for (auto& [sample, writer] : reader->take_all_with_writer()) {
+                                        std::string hex;
+                                        hex.reserve(sample.bytes.size() * 2);
+                                        for (const unsigned char byte : sample.bytes) {
+                                            hex += digits[byte >> 4];
+                                            hex += digits[byte & 0xf];
+                                        }
+                                        out.emplace_back(nlohmann::json{{"cdr_hex", hex}}, std::move(writer));
+                                    }
+                                }});
 }
 
 void TraceRecorder::drain(TimeNs t, int round) {

@@ -39,6 +39,13 @@ public:
     void drain(TimeNs t, int round);
     // Samples other participants wrote on rig-only topics, so far.
     const std::vector<ForeignSample>& foreign_samples() const { return foreign_; }
+    // Whether the recorder has a channel for the topic.
+    bool records(const std::string& topic) const;
+    // Records a topic of the controller's own (its diagnostics): decoded when the
+    // type is one of the rig's, else each sample as its serialized bytes,
+    // {"cdr_hex": "..."}; meta `own_topic:TOPIC` says the type. Channels added
+    // this way are drained after the known ones, in the order added.
+    void record_raw(const std::string& topic, const std::string& type_name);
 
 private:
     struct Channel {
@@ -46,8 +53,12 @@ private:
         // Appends (json, writer's GUID prefix) of every sample taken.
         std::function<void(std::vector<std::pair<nlohmann::json, std::string>>&)> take;
     };
+public:
+    // (Public for record_raw's table of known types.)
     template <class Msg>
     void add_channel(DdsContext& dds, const char* topic);
+
+private:
 
     DdsContext& dds_;
     TraceFile file_;

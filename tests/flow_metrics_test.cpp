@@ -1,6 +1,5 @@
-// The harness's flow and deposition metrics (DESIGN.md "What the harness
-// measures"; seed 000 Table 2, 5, 6 and Eq. 10-12) on hand-built truth with
-// known answers.
+// The harness's flow and deposition metrics (docs/metrics.md; seed 000 Table 2,
+// 5, 6 and Eq. 10-12) on hand-built truth with known answers.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Hard rule: the rig never sends to anything but 127.0.0.1 (DESIGN.md "DDS rules").
+// Hard rule: the rig never sends to anything but 127.0.0.1 (docs/design.md "DDS and the network").
 // Two independent observers, each shown able to see a forbidden destination:
 //  * the kernel's view: `strace -f` of `rig dds-check`, a two-process DDS
 //    exchange through the loopback profile (discovery + user data);

@@ -1,4 +1,4 @@
-// The results contract (DESIGN.md): results.json shape, well-formed escaped
+// The results contract (docs/design.md): results.json shape, well-formed escaped
 // JUnit XML, the judge's wording and the expected-failure logic.
 #include "harness/results_writer.h"
 

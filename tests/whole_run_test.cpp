@@ -1,4 +1,4 @@
-// Whole runs through `bin/rig` (DESIGN.md "Time", "Results contract"):
+// Whole runs through `bin/rig` (docs/design.md "Time", "Results"):
 //  * the same case and seed give the same trace, bit for bit; another seed does not;
 //  * a controller that stops answering fails the case by its name, in bounded time;
 //  * a broken case file stops the run before anything starts, naming file, line and key;
@@ -102,6 +102,31 @@ TEST(WholeRun, RejudgingTheTracesGivesExactlyTheRunsResults) {
     EXPECT_EQ(WIFEXITED(differs) ? WEXITSTATUS(differs) : -1, 1) << read_all(dir / "judge2.log");
     EXPECT_NE(read_all(dir / "judge2.log").find("metric flow_adjust_time_s was 0.5"), std::string::npos)
         << read_all(dir / "judge2.log");
+}
+
+// A topic a controller writes for its own diagnostics (here the reference
+// controller's phase changes, `diagnostics_topic`) is neither refused nor lost:
+// the rig, told of it in the hello, reads it without knowing its type and
+// records each sample's bytes (docs/controller-contract.md).
+TEST(WholeRun, AControllersOwnDiagnosticTopicIsRecorded) {
+    const fs::path dir = fresh_dir("diagnostics");
+    std::string text = read_all(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    const std::string controller_line = "controller: { positioning: fusion, threshold_m: 5.0 }";
+    const auto at = text.find(controller_line);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, controller_line.size(),
+                 "controller: { positioning: fusion, threshold_m: 5.0, diagnostics_topic: reference/phases }");
+    std::ofstream(dir / "diagnostics.yaml") << text;
+    const RunOutcome outcome = rig_run("'" + (dir / "diagnostics.yaml").string() + "'", dir / "out");
+    ASSERT_EQ(outcome.exit_code, 0) << outcome.log;
+    const fs::path trace = dir / "out" / "cases" / "short-fusion" / "trace.sqlite";
+    // Its type is one the rig knows (NmeaSentence, a line of text): decoded.
+    const std::string rows = read_all_command(
+        "sqlite3 '" + trace.string() +
+        "' \"select count(*) from samples where topic = 'reference/phases' and json like '%phase %'; "
+        "select value from meta where key = 'own_topic:reference/phases'\"");
+    EXPECT_GE(std::atoi(rows.c_str()), 1) << rows;
+    EXPECT_NE(rows.find("rig::msg::NmeaSentence"), std::string::npos) << rows;
 }
 
 TEST(WholeRun, ControllerThatStopsAnsweringFailsByNameInBoundedTime) {

@@ -1,7 +1,7 @@
 #pragma once
 // The one exception type for "this configuration is wrong": it points at the
 // file, line, column and key, so a mistake in a case file is reported like a
-// compiler error, before anything starts (DESIGN.md "Case files").
+// compiler error, before anything starts (docs/design.md "Case files").
 #include <stdexcept>
 #include <string>
 #include <utility>

@@ -2,7 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,35 +12,64 @@
 
 #include "rig/runtime/clock.h"
 
-extern char** environ;
-
 namespace rig {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path) {
     if (argv.empty()) throw std::runtime_error("empty command for a node process");
     for (const auto& arg : argv) command_line_ += (command_line_.empty() ? "" : " ") + arg;
 
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-
-    // Its own process group: a Ctrl-C at the terminal reaches the rig alone, which
-    // then ends the run and stops this process itself (and records why).
-    posix_spawnattr_t attributes;
-    posix_spawnattr_init(&attributes);
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
-    posix_spawnattr_setpgroup(&attributes, 0);
-
+    // Everything the child needs is prepared before fork: between fork and exec a
+    // multithreaded parent (DDS threads) allows only async-signal-safe calls.
     std::vector<char*> raw_argv;
     for (const auto& arg : argv) raw_argv.push_back(const_cast<char*>(arg.c_str()));
     raw_argv.push_back(nullptr);
-    const int rc = posix_spawnp(&pid_, raw_argv[0], &actions, &attributes, raw_argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    posix_spawnattr_destroy(&attributes);
-    if (rc != 0) {
-        throw std::runtime_error("cannot start '" + command_line_ + "': " + std::strerror(rc));
+    const std::string log = log_path.string();
+    const pid_t parent = ::getpid();
+
+    // exec failure travels back over a close-on-exec pipe: EOF means exec succeeded.
+    int report[2];
+    if (::pipe2(report, O_CLOEXEC) != 0) {
+        throw std::runtime_error("cannot start '" + command_line_ + "': pipe: " + std::strerror(errno));
+    }
+    pid_ = ::fork();
+    if (pid_ < 0) {
+        const int err = errno;
+        ::close(report[0]);
+        ::close(report[1]);
+        throw std::runtime_error("cannot start '" + command_line_ + "': fork: " + std::strerror(err));
+    }
+    if (pid_ == 0) {
+        // Its own process group: a Ctrl-C at the terminal reaches the rig alone,
+        // which then ends the run and stops the group itself (and records why).
+        ::setpgid(0, 0);
+        // If the rig dies without stopping it (SIGKILL, a crash), the controller
+        // dies too rather than living on in a DDS domain the next run will lease.
+        ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
+        int err = 0;
+        const int in = ::open("/dev/null", O_RDONLY);
+        const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (in < 0 || out < 0 || ::dup2(in, STDIN_FILENO) < 0 || ::dup2(out, STDOUT_FILENO) < 0 ||
+            ::dup2(out, STDERR_FILENO) < 0) {
+            err = errno;
+        } else {
+            ::execvp(raw_argv[0], raw_argv.data());
+            err = errno;
+        }
+        [[maybe_unused]] const auto written = ::write(report[1], &err, sizeof err);
+        ::_exit(127);
+    }
+    ::close(report[1]);
+    int child_errno = 0;
+    ssize_t got;
+    do got = ::read(report[0], &child_errno, sizeof child_errno);
+    while (got < 0 && errno == EINTR);
+    ::close(report[0]);
+    if (got == static_cast<ssize_t>(sizeof child_errno)) {
+        int status = 0;
+        ::waitpid(pid_, &status, 0);
+        pid_ = -1;
+        throw std::runtime_error("cannot start '" + command_line_ + "': " + std::strerror(child_errno));
     }
 }
 
@@ -59,9 +88,17 @@ std::string ChildProcess::describe_status(int status) {
 
 std::optional<std::string> ChildProcess::exit_description() {
     if (ended_) return ended_;
+    // Look without reaping: while the leader is a zombie its pid (= the group id)
+    // cannot be reused, so what is left of its group (a wrapper script's child)
+    // can be killed safely before the leader is reaped.
+    siginfo_t info{};
+    if (::waitid(P_PID, static_cast<id_t>(pid_), &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid != pid_) {
+        return ended_;
+    }
+    ::kill(-pid_, SIGKILL);
     int status = 0;
-    const pid_t rc = ::waitpid(pid_, &status, WNOHANG);
-    if (rc == pid_) ended_ = describe_status(status);
+    ::waitpid(pid_, &status, 0);
+    ended_ = describe_status(status);
     return ended_;
 }
 
@@ -69,7 +106,7 @@ std::string ChildProcess::stop(std::chrono::milliseconds grace) {
     // First let it finish on its own (a follower exits after the shutdown tick),
     // then ask with SIGTERM, then insist.
     for (int signal_to_send : {0, SIGTERM}) {
-        if (signal_to_send != 0) ::kill(pid_, signal_to_send);
+        if (signal_to_send != 0) ::kill(-pid_, signal_to_send);  // the whole group: wrappers' children too
         const WallStopwatch waited;
         while (waited.elapsed() < grace) {
             if (exit_description()) return *ended_;
@@ -77,7 +114,7 @@ std::string ChildProcess::stop(std::chrono::milliseconds grace) {
             nanosleep(&pause, nullptr);
         }
     }
-    ::kill(pid_, SIGKILL);
+    ::kill(-pid_, SIGKILL);
     int status = 0;
     ::waitpid(pid_, &status, 0);
     ended_ = describe_status(status) + " after SIGKILL";

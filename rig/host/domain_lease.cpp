@@ -12,8 +12,10 @@ namespace rig {
 DomainLease DomainLease::acquire(std::uint32_t first, std::uint32_t last) {
     // Round-robin from after the last domain this process took: a domain a case
     // has just left is not reused at once, while the previous controller process
-    // may still be on its way out and discovery still remembers it.
-    static std::atomic<std::uint32_t> next{0};
+    // may still be on its way out and discovery still remembers it. Each process
+    // starts at a place of its own (from its pid), so rig runs started together
+    // (ctest -j) do not all queue for the same first domains.
+    static std::atomic<std::uint32_t> next{static_cast<std::uint32_t>(::getpid())};
     const std::uint32_t span = last - first + 1;
     const std::uint32_t start = next.fetch_add(1) % span;
     for (std::uint32_t k = 0; k < span; ++k) {
@@ -26,6 +28,17 @@ DomainLease DomainLease::acquire(std::uint32_t first, std::uint32_t last) {
     }
     throw std::runtime_error("no free DDS domain id in [" + std::to_string(first) + ", " + std::to_string(last) +
                              "]: too many rig runs at once?");
+}
+
+DomainLease DomainLease::acquire_exact(std::uint32_t domain) {
+    // Fast DDS's well-known ports (7400 + 250 domain + ...) run out above 232.
+    if (domain > 232) throw std::runtime_error("DDS domain " + std::to_string(domain) + " is above 232");
+    const std::string path = "/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock";
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) throw std::runtime_error("cannot open " + path + " to lease DDS domain " + std::to_string(domain));
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return DomainLease(domain, fd);
+    ::close(fd);
+    throw std::runtime_error("DDS domain " + std::to_string(domain) + " is in use by another rig run (" + path + ")");
 }
 
 DomainLease::DomainLease(DomainLease&& other) noexcept : domain_id_(other.domain_id_), fd_(other.fd_) {

@@ -1,5 +1,5 @@
 #pragma once
-// The one time abstraction every node uses (DESIGN.md "Time"). Nothing outside
+// The one time abstraction every node uses (docs/design.md "Time"). Nothing outside
 // rig/ reads the wall clock or sleeps: nodes get the time from a Clock, and in
 // lockstep the harness decides what time it is.
 #include <chrono>

@@ -1,8 +1,10 @@
 #include "rig/runtime/dds_context.h"
 
 #include <algorithm>
+#include <functional>
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
@@ -197,6 +199,52 @@ dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*ma
     if (participant_->find_type(type_name).empty()) {
         if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
             throw std::runtime_error("cannot register DDS type " + type_name);
+        }
+    }
+    dds::Topic* topic = participant_->create_topic(name, type_name, participant_->get_default_topic_qos());
+    if (topic == nullptr) throw std::runtime_error("cannot create DDS topic " + name + " of type " + type_name);
+    topics_.emplace(name, topic);
+    return topic;
+}
+
+namespace {
+
+// A topic type known by name only: serialized samples pass through as bytes.
+class RawPayloadType final : public dds::TopicDataType {
+public:
+    explicit RawPayloadType(const std::string& type_name) {
+        setName(type_name.c_str());
+        m_typeSize = 64 * 1024;  // enough for any diagnostic sample; larger ones are refused, not truncated
+        m_isGetKeyDefined = false;
+    }
+    bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+        const auto& bytes = static_cast<RawSample*>(data)->bytes;
+        if (bytes.size() > payload->max_size) return false;
+        std::copy(bytes.begin(), bytes.end(), payload->data);
+        payload->length = static_cast<std::uint32_t>(bytes.size());
+        return true;
+    }
+    bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
+        auto& bytes = static_cast<RawSample*>(data)->bytes;
+        bytes.assign(payload->data, payload->data + payload->length);
+        return true;
+    }
+    std::function<std::uint32_t()> getSerializedSizeProvider(void* data) override {
+        return [data] { return static_cast<std::uint32_t>(static_cast<RawSample*>(data)->bytes.size()); };
+    }
+    void* createData() override { return new RawSample(); }
+    void deleteData(void* data) override { delete static_cast<RawSample*>(data); }
+    bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
+};
+
+}  // namespace
+
+dds::Topic* DdsContext::raw_topic(const std::string& name, const std::string& type_name) {
+    if (auto it = topics_.find(name); it != topics_.end()) return it->second;
+    if (participant_->find_type(type_name).empty()) {
+        dds::TypeSupport type(new RawPayloadType(type_name));
+        if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+            throw std::runtime_error("cannot register DDS type " + type_name + " (raw, for topic " + name + ")");
         }
     }
     dds::Topic* topic = participant_->create_topic(name, type_name, participant_->get_default_topic_qos());

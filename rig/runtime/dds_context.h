@@ -154,6 +154,13 @@ public:
     }
 };
 
+// A sample of a topic whose type the rig does not know (a controller's own
+// diagnostic topic): its serialized bytes as they came, encapsulation header
+// included. RawReader records them without decoding.
+struct RawSample {
+    std::vector<unsigned char> bytes;
+};
+
 class DdsContext {
 public:
     // `watch_discovery`: keep every endpoint other participants create or remove
@@ -178,6 +185,9 @@ public:
     dds::DomainParticipant& participant() { return *participant_; }
     dds::Publisher& publisher() { return *publisher_; }
     dds::Subscriber& subscriber() { return *subscriber_; }
+
+    // A topic whose type is only known by name (the rig reads its samples as raw bytes).
+    dds::Topic* raw_topic(const std::string& name, const std::string& type_name);
 
     template <class Msg>
     dds::Topic* topic(const std::string& name) {
@@ -236,6 +246,20 @@ private:
     std::mutex arrival_mutex_;
     std::condition_variable arrival_;
     std::uint64_t arrivals_ = 0;
+};
+
+// Reads any topic as raw serialized samples (RawSample), whatever its type.
+class RawReader final : public ReaderBase {
+public:
+    RawReader(DdsContext& context, const std::string& topic_name, const std::string& type_name)
+        : ReaderBase(context, topic_name, context.raw_topic(topic_name, type_name)) {}
+    std::vector<std::pair<RawSample, std::string>> take_all_with_writer() {
+        std::vector<std::pair<RawSample, std::string>> samples;
+        RawSample sample;
+        std::string writer;
+        while (take_raw(&sample, &writer)) samples.emplace_back(sample, writer);
+        return samples;
+    }
 };
 
 template <class Msg>

@@ -6,7 +6,7 @@
 // HID board) and the controller's hardware interface share one vocabulary
 // (ros2_control-style: real or mock hardware behind one interface).
 //
-// Values are wire-level, not engineering units (DESIGN.md "Data flow"): pulse
+// Values are wire-level, not engineering units (docs/design.md "Data flow"): pulse
 // counts, ADC counts, relay and valve states. The controller converts them
 // (seed 000 Eq. 3, 5, 8) as firmware must.
 #include <cstdint>

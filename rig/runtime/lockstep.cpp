@@ -111,6 +111,13 @@ void LockstepMaster::start() {
         }
         // Hello: seq 0.
         tick_remotes(0, false);
+        if (after_hello_) {
+            std::vector<std::string> published;
+            for (const Remote& remote : remotes_) {
+                published.insert(published.end(), remote.published_topics.begin(), remote.published_topics.end());
+            }
+            after_hello_(published);
+        }
     }
 
     // Every writer must reach every reader of its topic (local ones and the remotes
@@ -332,17 +339,19 @@ FollowerLink::FollowerLink(DdsContext& dds, const FollowerOptions& options)
       ack_writer_(std::make_unique<Writer<msg::ClockAck>>(dds, topics::kClockAck, false)) {}
 
 bool FollowerLink::wait_matched() {
-    // Every endpoint must be matched before we say hello; a node reading a topic no
-    // one writes is a configuration error the master reports with our name.
+    // Every reader must have a writer before we say hello: a node reading a topic
+    // no one writes is a configuration error the master reports with our name.
+    // Writers need no reader yet: a topic a controller writes for its own
+    // diagnostics has none until the rig, told of it in the hello, records it;
+    // the first tick's reader counts then say whom each writer must reach.
     const WallStopwatch startup;
     for (;;) {
         std::vector<std::string> unmatched;
         for (ReaderBase* reader : dds_.readers()) {
             if (reader->matched_writers() < 1) unmatched.push_back("reads " + reader->topic_name());
         }
-        for (WriterBase* writer : dds_.writers()) {
-            if (writer->matched_readers() < 1) unmatched.push_back("writes " + writer->topic_name());
-        }
+        // The clock's own ack writer must reach the master, or the hello is lost.
+        if (ack_writer_->matched_readers() < 1) unmatched.push_back("writes " + ack_writer_->topic_name());
         if (unmatched.empty()) return true;
         if (startup.elapsed() > options_.startup_timeout) {
             std::string list;

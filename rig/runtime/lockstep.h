@@ -1,5 +1,5 @@
 #pragma once
-// Lockstep virtual time over DDS (DESIGN.md "Time").
+// Lockstep virtual time over DDS (docs/design.md "Time").
 //
 // Protocol, per simulated instant t:
 //   round 0: the master steps every local node due at t, then sends
@@ -86,6 +86,13 @@ public:
     // (a stop signal, its wall-time bound, topic roles seen in discovery) and
     // throws NodeFailure to end the run.
     void set_watchdog(std::function<void()> callback) { watchdog_ = std::move(callback); }
+    // Called once the remotes answered the hello, with every topic they said they
+    // write, before the endpoints are matched: the recorder adds readers for
+    // topics it does not know yet (a controller's own diagnostics), so that they
+    // are matched and counted like the others.
+    void set_after_hello(std::function<void(const std::vector<std::string>&)> callback) {
+        after_hello_ = std::move(callback);
+    }
 
     // Configure local nodes, wait for remote hellos and endpoint matching, activate.
     void start();
@@ -137,6 +144,7 @@ private:
     std::unique_ptr<Reader<msg::ClockAck>> ack_reader_;
     std::function<void(TimeNs, int)> after_round_;
     std::function<void()> watchdog_;
+    std::function<void(const std::vector<std::string>&)> after_hello_;
     std::uint64_t seq_ = 0;
     TimeNs now_ns_ = 0;
     bool started_ = false;

@@ -1,5 +1,5 @@
 #pragma once
-// Real-time runs (DESIGN.md "Time", issue: bench acceptance): every node on the
+// Real-time runs (docs/design.md "Time", issue: bench acceptance): every node on the
 // wall clock with absolute deadlines, for a controller board on real wires or a
 // controller process that keeps its own time.
 //
@@ -71,6 +71,10 @@ public:
     void set_watchdog(std::function<void()> callback) {
         watchdog_ = callback;
         remotes_.set_watchdog(std::move(callback));
+    }
+    // As LockstepMaster::set_after_hello.
+    void set_after_hello(std::function<void(const std::vector<std::string>&)> callback) {
+        remotes_.set_after_hello(std::move(callback));
     }
 
     // Configures the local nodes, says hello to the remotes, waits for every

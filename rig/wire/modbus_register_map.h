@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus register map of the bench wire (DESIGN.md "Who uses it": a real
+// The Modbus register map of the bench wire (docs/design.md "Who uses it": a real
 // controller board wired to the rig over Modbus RTU/TCP). The rig is the slave
 // (server) and serves the board's inputs; the controller board is the master
 // (client) and writes its outputs. Same vocabulary as every other wire:

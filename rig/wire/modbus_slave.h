@@ -35,7 +35,7 @@ namespace rig::modbus {
 
 struct TcpSlaveOptions {
     // Loopback only unless allow_non_loopback: these machines never talk to
-    // anything but 127.0.0.1 (DESIGN.md). A bench with a board on Ethernet
+    // anything but 127.0.0.1 (docs/design.md). A bench with a board on Ethernet
     // sets it explicitly.
     std::string bind_address = "127.0.0.1";
     std::uint16_t port = kDefaultBenchTcpPort;  // 0 = any free port; ModbusSlave::tcp_port() tells which
