@@ -9,6 +9,7 @@
 #include <set>
 #include <thread>
 
+#include "controller/boundary/boundary_node_config.h"
 #include "controller/controller_config.h"
 #include "emulators/boom_height_sensor.h"
 #include "emulators/flow_meter_kf11.h"
@@ -18,6 +19,7 @@
 #include "emulators/spray_circuit.h"
 #include "emulators/spray_circuit_node.h"
 #include "emulators/wheel_encoder.h"
+#include "harness/boundary_runner.h"
 #include "harness/case_session.h"
 #include "harness/case_world.h"
 #include "harness/run_interrupt.h"
@@ -287,7 +289,9 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
 void validate_for_run(const CaseSpec& spec, const RunOptions& /*options*/) {
     // The reference controller's own keys are checked before anything starts; a
     // case naming another controller leaves its section to that controller.
-    if (spec.controller.command.empty()) {
+    if (spec.controller.command.empty() && spec.system == CaseSystem::boundary) {
+        controller::boundary::parse_boundary_node_config(YamlSection(spec.controller.params));
+    } else if (spec.controller.command.empty()) {
         controller::parse_controller_config(YamlSection(spec.controller.params));
     }
 }
@@ -313,6 +317,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 }
 
 CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options) {
+    if (spec.system == CaseSystem::boundary) return run_boundary_case(spec, seed, run_name, options);
     const WallStopwatch wall;
     const std::filesystem::path case_dir = options.out_dir / "cases" / run_name;
     const std::filesystem::path trace_file = case_dir / "trace.sqlite";
