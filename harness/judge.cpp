@@ -110,7 +110,7 @@ const std::set<std::string>& judged_topics() {
     static const std::set<std::string> topics = {
         topics::kVehicleTruth,     topics::kHydraulicsTruth,  topics::kSectionValves,
         topics::kBreakpointEvent,  topics::kControllerStatus, topics::kMainFlowMeter,
-        topics::kVehicle2dTruth,   topics::kNozzlesTruth,     topics::kNozzlePwm,
+        topics::kVehicle2dTruth,   topics::kNozzlesTruth,
     };
     return topics;
 }
