@@ -129,8 +129,11 @@ BoundaryCaseSpec read_boundary_case(const YamlSection& root) {
             points.push_back(field2d::FlowPoint{point.required_in_range<double>("duty_pct", kFinite),
                                                 point.required_in_range<double>("flow_ml_min", kFinite)});
         }
+        // Table 3 has 8 duties; a calibration table of more than 100 is no measurement.
+        if (points.size() > 100) nozzle.fail("points", "at most 100 points per nozzle");
         spec.flow_table.push_back(std::move(points));
     }
+    if (spec.flow_table.size() > 32) spray.fail("flow_table", "at most 32 nozzles (the boom's limit)");
 
     const YamlSection valves = root.section("valves");
     read(valves, "frequency_hz", spec.valves.frequency_hz);
@@ -171,6 +174,8 @@ BoundaryCaseSpec read_boundary_case(const YamlSection& root) {
         spec.edges.push_back(read_edge(edge));
         spec.edges.back().probe.wet_threshold_ul_cm2 = spec.wet_threshold_ul_cm2;
     }
+    // Each edge is a wet-edge profile over the whole ground: a handful per case.
+    if (spec.edges.size() > 16) judge.fail("edges", "at most 16 edges");
     spec.judge_flow_per_duty = judge.optional<bool>("flow_per_duty", spec.judge_flow_per_duty);
     spec.flow_settle_s = judge.optional_in_range<double>("flow_settle_s", spec.flow_settle_s, Bounds::closed(0, 60));
     spec.end_after_route_s =
@@ -213,7 +218,9 @@ void check_boundary_case(const BoundaryCaseSpec& spec, const YamlSection& root) 
 
 RawYaml controller_section_with_area(const RawYaml& controller, const BoundaryCaseSpec& spec) {
     RawYaml out = controller;
-    out.node = controller.present && controller.node.IsMap() ? YAML::Clone(controller.node) : YAML::Node(YAML::NodeType::Map);
+    // In place (not a clone): the section's nodes keep their marks, so the
+    // controller's own errors still point at the case file's lines.
+    if (!(controller.present && controller.node.IsMap())) out.node = YAML::Node(YAML::NodeType::Map);
     out.present = true;
     if (out.node["areas"]) return out;
     YAML::Node area;
