@@ -9,6 +9,7 @@
 #include <set>
 #include <thread>
 
+#include "controller/boundary/boundary_node_config.h"
 #include "emulators/boom_height_sensor.h"
 #include "emulators/flow_meter_kf11.h"
 #include "emulators/panel_switch.h"
@@ -17,6 +18,7 @@
 #include "emulators/spray_circuit.h"
 #include "emulators/spray_circuit_node.h"
 #include "emulators/wheel_encoder.h"
+#include "harness/boundary_runner.h"
 #include "harness/case_session.h"
 #include "harness/case_world.h"
 #include "harness/run_interrupt.h"
@@ -291,6 +293,12 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
 }  // namespace
 
 void validate_for_run(const CaseSpec& spec, const RunOptions& options) {
+    // Seed 001's reference boundary controller (a program; its configuration
+    // library is the harness's too).
+    if (spec.system == CaseSystem::boundary && spec.controller.command.empty()) {
+        controller::boundary::parse_boundary_node_config(YamlSection(spec.controller.params));
+        return;
+    }
     // The controller's own keys are checked before anything starts, by its
     // plugin (the harness does not link the reference controller): the
     // reference controller's, or the plugin a case names. A program without a
@@ -324,6 +332,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 }
 
 CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options) {
+    if (spec.system == CaseSystem::boundary) return run_boundary_case(spec, seed, run_name, options);
     const WallStopwatch wall;
     const std::filesystem::path case_dir = options.out_dir / "cases" / run_name;
     const std::filesystem::path trace_file = case_dir / "trace.sqlite";

@@ -50,6 +50,13 @@ TraceRecorder::TraceRecorder(DdsContext& dds, const std::filesystem::path& file)
     add_channel<msg::BreakpointEvent>(dds, topics::kBreakpointEvent);
 }
 
+void TraceRecorder::record_boundary_topics() {
+    add_channel<msg::SerialLine>(dds_, topics::kLaserHeightSerial);
+    add_channel<msg::NozzlePwm>(dds_, topics::kNozzlePwm);
+    add_channel<msg::Vehicle2dTruth>(dds_, topics::kVehicle2dTruth);
+    add_channel<msg::NozzlesTruth>(dds_, topics::kNozzlesTruth);
+}
+
 bool TraceRecorder::records(const std::string& topic) const {
     return std::any_of(channels_.begin(), channels_.end(), [&](const Channel& channel) { return channel.topic == topic; });
 }
