@@ -82,6 +82,12 @@ struct RunFacts {
     std::string controller_mode;     // process, in_process, external
     std::string in_process_refused;  // asked for in process, ran as a process: why
     double startup_wall_seconds = 0.0;
+    // Lockstep: simulated instants processed and rounds run (a round: the local
+    // nodes, then one tick to the controller and its answer), and the wall time
+    // from the end of start-up to the last instant (rig bench's per-round cost).
+    std::uint64_t instants = 0;
+    std::uint64_t rounds = 0;
+    double stepping_wall_seconds = 0.0;
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
 };
@@ -187,6 +193,7 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         master.add_in_process_node(controller->node(), controller->dds());
     }
     master.set_after_round([&](TimeNs t, int round) {
+        ++facts.rounds;
         now_ns = t;
         trace.drain(t, round);
     });
@@ -195,8 +202,8 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     try {
         master.start();
         facts.startup_wall_seconds = wall.elapsed_s();
-        while (master.advance(end_ns)) {
-        }
+        while (master.advance(end_ns)) ++facts.instants;
+        facts.stepping_wall_seconds = wall.elapsed_s() - facts.startup_wall_seconds;
         master.shutdown();
     } catch (const NodeFailure&) {
         master.shutdown(/*after_failure=*/true);
@@ -263,6 +270,9 @@ nlohmann::json run_facts_json(const RunFacts& facts, double wall_seconds) {
             {"controller_mode", facts.controller_mode},
             {"in_process_refused", facts.in_process_refused},
             {"startup_wall_seconds", facts.startup_wall_seconds},
+            {"instants", facts.instants},
+            {"rounds", facts.rounds},
+            {"stepping_wall_seconds", facts.stepping_wall_seconds},
             {"realtime_scheduling", facts.realtime_scheduling},
             {"emission_jitter", std::move(jitter)}};
 }

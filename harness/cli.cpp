@@ -1,5 +1,6 @@
 // `rig`: the rig's one command line (README "Running cases", `rig --help`).
-//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N]
+//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process] [--domain N]
+//   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--out DIR]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
 //   rig dds-check [--samples N] [--log-dir DIR]
@@ -26,7 +27,9 @@
 #include "harness/run_interrupt.h"
 #include "rig/runtime/clock.h"
 #include "rig/config/config_error.h"
+#include "harness/speed_bench.h"
 #include "rig/host/dds_check.h"
+#include "rig/host/dds_pingpong.h"
 
 namespace {
 
@@ -168,6 +171,19 @@ int main(int argc, char** argv) {
     check->add_flag("--echo", check_echo, "internal: be the echo side")->group("");
     check->add_option("--domain", check_domain, "internal: the echo side's domain")->group("");
 
+    rig::harness::SpeedBenchOptions bench_options;
+    bool bench_pong = false;
+    std::uint32_t bench_domain = 0;
+    auto* bench = app.add_subcommand(
+        "bench", "what lockstep costs: runs cases in process and in-process (SIL) mode beside a DDS ping-pong floor");
+    bench->add_option("cases", bench_options.cases, "lockstep case files");
+    bench->add_option("--repeat", bench_options.repeat, "runs per case and mode")->check(CLI::Range(1, 1000));
+    bench->add_option("--pingpong-rounds", bench_options.pingpong.rounds, "timed DDS round trips")
+        ->check(CLI::Range(10, 1000000));
+    bench->add_option("--out", bench_options.out_dir, "traces and bench.json");
+    bench->add_flag("--pong", bench_pong, "internal: be the ping-pong's second process")->group("");
+    bench->add_option("--domain", bench_domain, "internal: the second process's domain")->group("");
+
     rig::harness::ModbusServeOptions modbus_serve_options;
     auto* modbus = app.add_subcommand("modbus", "Modbus bench wire tools");
     modbus->require_subcommand(1);
@@ -191,6 +207,18 @@ int main(int argc, char** argv) {
     if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);
     if (decode->parsed()) return nmea_decode_command(nmea_input);
     if (modbus_serve->parsed()) return rig::harness::run_modbus_serve_command(modbus_serve_options);
+    if (bench->parsed()) {
+        try {
+            if (bench_pong) return rig::run_dds_pong(bench_domain, bench_options.pingpong.rounds);
+            bench_options.run = run_options;
+            bench_options.pingpong.pong_executable = own_directory() / "rig";
+            bench_options.pingpong.log_dir = bench_options.out_dir;
+            return rig::harness::run_speed_bench(bench_options, std::cout, std::cerr);
+        } catch (const std::exception& error) {
+            std::cerr << "rig bench: " << error.what() << "\n";
+            return 1;
+        }
+    }
     if (check->parsed()) {
         try {
             if (check_echo) return rig::run_dds_echo(check_domain, check_options.samples, std::cout);

@@ -427,6 +427,9 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     }
     result.wall_seconds = run.value("wall_seconds", 0.0);
     result.startup_wall_seconds = run.value("startup_wall_seconds", 0.0);
+    result.instants = run.value("instants", std::uint64_t{0});
+    result.rounds = run.value("rounds", std::uint64_t{0});
+    result.stepping_wall_seconds = run.value("stepping_wall_seconds", 0.0);
     result.controller_mode = run.value("controller_mode", std::string());
     result.in_process_refused = run.value("in_process_refused", std::string());
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());

@@ -428,6 +428,9 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"sim_seconds", result.sim_seconds},
             {"wall_seconds", result.wall_seconds},
             {"startup_wall_seconds", result.startup_wall_seconds},
+            {"instants", result.instants},
+            {"rounds", result.rounds},
+            {"stepping_wall_seconds", result.stepping_wall_seconds},
             {"mode", valid_utf8(result.mode)},
             {"controller_mode", valid_utf8(result.controller_mode)},
         };

@@ -42,6 +42,10 @@ struct CaseResult {
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
     double startup_wall_seconds = 0.0;  // of wall_seconds: process start, DDS discovery, hello
+    // Lockstep: instants and rounds run, and the wall time they took (after start-up).
+    std::uint64_t instants = 0;
+    std::uint64_t rounds = 0;
+    double stepping_wall_seconds = 0.0;
     std::string mode = "lockstep";      // or "realtime"
     // Where the controller ran: "process", "in_process" (a plugin, software-in-the-loop)
     // or "external" (a wired board); empty in traces from before it was recorded.

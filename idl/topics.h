@@ -11,6 +11,10 @@ inline constexpr const char* kClockAck = "rig/clock/ack";            // msg::Clo
 // Bench self-test (rig/host/dds_check.h)
 inline constexpr const char* kDdsCheckPing = "rig/dds_check/ping";  // msg::NmeaSentence
 inline constexpr const char* kDdsCheckPong = "rig/dds_check/pong";  // msg::NmeaSentence
+// The DDS floor of a lockstep round (rig/host/dds_pingpong.h, `rig bench`): the
+// clock's own types and QoS on topics of their own.
+inline constexpr const char* kBenchPing = "rig/bench/ping";  // msg::ClockTick
+inline constexpr const char* kBenchPong = "rig/bench/pong";  // msg::ClockAck
 
 // Device topics (emulators -> controller)
 inline constexpr const char* kGnssNmea = "device/gnss/nmea";                        // msg::NmeaSentence

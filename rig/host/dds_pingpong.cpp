@@ -1,0 +1,112 @@
+#include "rig/host/dds_pingpong.h"
+
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
+#include "idl/topics.h"
+#include "rig/host/child_process.h"
+#include "rig/host/domain_lease.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+
+namespace rig {
+namespace {
+
+constexpr auto kMatchTimeout = std::chrono::milliseconds(15'000);
+constexpr auto kAnswerTimeout = std::chrono::milliseconds(5'000);
+
+double percentile(std::vector<double> values, double fraction) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const auto index = static_cast<std::size_t>(fraction * static_cast<double>(values.size() - 1) + 0.5);
+    return values[std::min(index, values.size() - 1)];
+}
+
+}  // namespace
+
+PingPongResult run_dds_pingpong(const PingPongOptions& options) {
+    const DomainLease lease = DomainLease::acquire();
+    DdsContext dds(lease.domain_id(), "bench-ping");
+    // As the lockstep master's clock endpoints: writers that are not output.
+    Writer<msg::ClockTick> ping(dds, topics::kBenchPing, /*counts_as_output=*/false);
+    Reader<msg::ClockAck> pong(dds, topics::kBenchPong);
+
+    std::filesystem::create_directories(options.log_dir);
+    const std::uint32_t total = options.warmup_rounds + options.rounds;
+    ChildProcess echo({options.pong_executable.string(), "bench", "--pong", "--domain", std::to_string(lease.domain_id()),
+                       "--pingpong-rounds", std::to_string(total)},
+                      options.log_dir / "bench-pong.log");
+    auto fail = [&](const std::string& what) -> PingPongResult {
+        const std::string ended = echo.stop(std::chrono::milliseconds(500));
+        throw std::runtime_error("DDS ping-pong: " + what + " (second process: " + ended + ")");
+    };
+
+    PingPongResult result;
+    const WallStopwatch since_start;
+    while (ping.matched_readers() < 1 || pong.matched_writers() < 1) {
+        if (since_start.elapsed() > kMatchTimeout) return fail("the second process was not matched within 15 s");
+        if (auto gone = echo.exit_description()) return fail("it ended before matching");
+        pong.wait_for_data(std::chrono::milliseconds(5));
+    }
+    result.matched_after_s = since_start.elapsed_s();
+
+    msg::ClockTick tick;
+    tick.reader_counts().clear();
+    for (std::uint32_t i = 0; i < options.topics_in_tick; ++i) {
+        msg::TopicCount count;
+        count.topic("device/bench/topic_" + std::to_string(i));
+        count.samples(i);
+        tick.published_counts().push_back(count);
+    }
+    std::vector<double> round_trips_us;
+    round_trips_us.reserve(options.rounds);
+    for (std::uint32_t seq = 1; seq <= total; ++seq) {
+        tick.seq(seq);
+        tick.time_ns(static_cast<TimeNs>(seq) * 10'000'000);
+        const WallStopwatch round_trip;
+        ping.publish(tick);
+        bool answered = false;
+        while (!answered) {
+            if (!pong.wait_for_data(kAnswerTimeout)) return fail("no answer to ping " + std::to_string(seq) + " within 5 s");
+            for (const msg::ClockAck& ack : pong.take_all()) answered |= ack.seq() == seq;
+        }
+        if (seq > options.warmup_rounds) round_trips_us.push_back(round_trip.elapsed_s() * 1e6);
+    }
+    const std::string ended = echo.stop(std::chrono::milliseconds(5000));
+    if (ended != "process exited with status 0") throw std::runtime_error("DDS ping-pong: the second process " + ended);
+    result.rounds = options.rounds;
+    result.mean_us = std::accumulate(round_trips_us.begin(), round_trips_us.end(), 0.0) /
+                     static_cast<double>(std::max<std::size_t>(1, round_trips_us.size()));
+    result.p50_us = percentile(round_trips_us, 0.50);
+    result.p99_us = percentile(round_trips_us, 0.99);
+    return result;
+}
+
+int run_dds_pong(std::uint32_t domain_id, std::uint32_t rounds) {
+    DdsContext dds(domain_id, "bench-pong");
+    Reader<msg::ClockTick> ping(dds, topics::kBenchPing);
+    Writer<msg::ClockAck> pong(dds, topics::kBenchPong, /*counts_as_output=*/false);
+    msg::ClockAck ack;
+    ack.node_name("bench-pong");
+    std::uint32_t answered = 0;
+    while (answered < rounds) {
+        if (!ping.wait_for_data(kMatchTimeout)) {
+            std::cerr << "bench pong: no ping for 15 s after " << answered << " answers; giving up\n";
+            return 1;
+        }
+        for (const msg::ClockTick& tick : ping.take_all()) {
+            ack.seq(tick.seq());
+            ack.next_wake_ns(tick.time_ns() + 10'000'000);
+            pong.publish(ack);
+            ++answered;
+        }
+    }
+    const auto undelivered = dds.wait_all_delivered(std::chrono::milliseconds(5'000));
+    return undelivered.empty() ? 0 : 1;
+}
+
+}  // namespace rig
