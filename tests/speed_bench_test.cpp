@@ -1,0 +1,57 @@
+// `rig bench` (issue 11): it runs, prints one table with the DDS floor and both
+// modes, and writes bench.json with what it measured. Behaviour only: the
+// numbers are the machine's (a loaded CI runner's are not a claim), so nothing
+// here asserts a speed.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "run_support.h"
+
+namespace {
+
+using rig::testing::fresh_dir;
+using rig::testing::read_all;
+using rig::testing::read_all_command;
+
+TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
+    const std::filesystem::path dir = fresh_dir("speed_bench");
+    const std::string output = read_all_command(
+        std::string(RIG_BINARY_DIR) + "/bin/rig bench " + RIG_SOURCE_DIR +
+        "/cases/table5-6-continuation/continuation-6kmh.yaml --repeat 1 --pingpong-rounds 50 --out " + dir.string() +
+        " 2>&1; echo \"exit=$?\"");
+    EXPECT_NE(output.find("exit=0"), std::string::npos) << output;
+    EXPECT_NE(output.find("DDS ping-pong, 2 processes"), std::string::npos) << output;
+    EXPECT_NE(output.find("process mode"), std::string::npos) << output;
+    EXPECT_NE(output.find("in process (SIL)"), std::string::npos) << output;
+    EXPECT_NE(output.find("trace digests identical in every run of both modes"), std::string::npos) << output;
+
+    ASSERT_TRUE(std::filesystem::exists(dir / "bench.json")) << output;
+    const nlohmann::json bench = nlohmann::json::parse(read_all(dir / "bench.json"));
+    EXPECT_TRUE(bench.at("digests_identical").get<bool>());
+    EXPECT_EQ(bench.at("pingpong").at("rounds").get<int>(), 50);
+    EXPECT_GT(bench.at("pingpong").at("p50_us").get<double>(), 0.0);
+    for (const char* mode : {"process", "in_process"}) {
+        SCOPED_TRACE(mode);
+        const nlohmann::json& figures = bench.at(mode);
+        // One run of a 66.7 s case on the 100 Hz device grid: thousands of rounds.
+        EXPECT_GT(figures.at("rounds").get<std::uint64_t>(), 6000u);
+        EXPECT_GT(figures.at("us_per_round").get<double>(), 0.0);
+        EXPECT_GT(figures.at("x_real_time").get<double>(), 0.0);
+        EXPECT_GT(figures.at("trace_bytes_per_sim_minute").get<double>(), 0.0);
+        EXPECT_GT(figures.at("startup_p50_s").get<double>(), 0.0);
+    }
+    // Both modes recorded the same samples: the same trace size.
+    EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"), bench.at("in_process").at("trace_bytes_per_sim_minute"));
+}
+
+TEST(SpeedBench, ARealTimeCaseIsRefusedNamingWhy) {
+    const std::filesystem::path dir = fresh_dir("speed_bench_realtime");
+    const std::string output = read_all_command(std::string(RIG_BINARY_DIR) + "/bin/rig bench " + RIG_SOURCE_DIR +
+                                                "/cases/bench-wired/continuation-6kmh-wired-rtu.yaml --out " +
+                                                dir.string() + " 2>&1; echo \"exit=$?\"");
+    EXPECT_NE(output.find("exit=2"), std::string::npos) << output;
+    EXPECT_NE(output.find("real-time case runs at 1x"), std::string::npos) << output;
+}
+
+}  // namespace
