@@ -67,6 +67,8 @@ BEGIN;
 // Rows per committed batch: small enough that a killed run loses little, large
 // enough that commits cost nothing measurable.
 constexpr std::uint64_t kRowsPerBatch = 4096;
+// Rows queued for the writer thread at most (about a simulated second of a case).
+constexpr std::size_t kMaxQueuedRows = 16384;
 
 }  // namespace
 
@@ -87,9 +89,18 @@ TraceFile::TraceFile(const std::filesystem::path& file) : file_(file) {
     EVP_DigestInit_ex(digest_, EVP_sha256(), nullptr);
     set_meta("trace_format", std::to_string(kTraceFormat));
     set_meta("outcome", "running");
+    writer_ = std::thread([this] { writer_loop(); });
 }
 
 TraceFile::~TraceFile() {
+    if (db_ != nullptr && writer_.joinable()) {
+        try {
+            sync();
+        } catch (const std::exception& error) {
+            std::cerr << "rig: trace " << file_.string() << ": " << error.what() << "\n";
+        }
+    }
+    stop_writer();
     if (db_ != nullptr) {
         try {
             finish(TraceOutcome{"interrupted", "interrupted", "the run ended before its trace was finished", last_t_ns_});
@@ -113,8 +124,48 @@ void TraceFile::exec(const char* sql) {
 
 void TraceFile::digest(const std::string& canonical) { EVP_DigestUpdate(digest_, canonical.data(), canonical.size()); }
 
+void TraceFile::writer_loop() {
+    std::deque<PendingRow> batch;
+    for (;;) {
+        {
+            std::unique_lock lock(queue_mutex_);
+            writing_ = false;
+            drained_.notify_all();
+            queued_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+            if (queue_.empty()) return;  // stopping, nothing left
+            batch.swap(queue_);
+            writing_ = true;
+        }
+        drained_.notify_all();  // room in the queue again
+        try {
+            for (const PendingRow& row : batch) write_row(row);
+        } catch (const std::exception& error) {
+            std::lock_guard lock(queue_mutex_);
+            if (writer_error_.empty()) writer_error_ = error.what();
+        }
+        batch.clear();
+    }
+}
+
+void TraceFile::sync() {
+    std::unique_lock lock(queue_mutex_);
+    drained_.wait(lock, [this] { return queue_.empty() && !writing_; });
+    if (!writer_error_.empty()) throw std::runtime_error(writer_error_);
+}
+
+void TraceFile::stop_writer() noexcept {
+    if (!writer_.joinable()) return;
+    {
+        std::lock_guard lock(queue_mutex_);
+        stopping_ = true;
+    }
+    queued_.notify_all();
+    writer_.join();
+}
+
 void TraceFile::set_meta(const std::string& key, const std::string& value) {
     if (db_ == nullptr) throw std::logic_error("trace " + file_.string() + ": set_meta after finish");
+    if (writer_.joinable()) sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT OR REPLACE INTO meta VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
         throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
@@ -127,7 +178,25 @@ void TraceFile::set_meta(const std::string& key, const std::string& value) {
 }
 
 void TraceFile::append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json) {
-    const std::string text = json.dump();
+    if (db_ == nullptr) throw std::logic_error("trace " + file_.string() + ": append after finish");
+    bool was_empty = false;
+    {
+        std::unique_lock lock(queue_mutex_);
+        drained_.wait(lock, [this] { return queue_.size() < kMaxQueuedRows || !writer_error_.empty(); });
+        if (!writer_error_.empty()) throw std::runtime_error(writer_error_);
+        was_empty = queue_.empty();
+        queue_.push_back(PendingRow{t, round, topic, json});
+    }
+    if (was_empty) queued_.notify_one();
+    last_t_ns_ = t;
+    ++rows_;
+}
+
+void TraceFile::write_row(const PendingRow& row) {
+    const TimeNs t = row.t;
+    const int round = row.round;
+    const std::string& topic = row.topic;
+    const std::string text = row.json.dump();
     digest(std::to_string(t) + " " + std::to_string(round) + " " + topic + " " + text + "\n");
     sqlite3_bind_int64(insert_, 1, t);
     sqlite3_bind_int(insert_, 2, round);
@@ -137,8 +206,6 @@ void TraceFile::append(TimeNs t, int round, const std::string& topic, const nloh
         throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
     }
     sqlite3_reset(insert_);
-    last_t_ns_ = t;
-    ++rows_;
     if (++rows_in_batch_ >= kRowsPerBatch) {
         exec("COMMIT; BEGIN;");
         rows_in_batch_ = 0;
@@ -150,6 +217,7 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
     // Not in the digest: the run failed on it, and the digest stays what the
     // samples, the deposition and the landing edges alone give (rig judge
     // recomputes it from those tables).
+    sync();
     const std::string text = json.dump();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO foreign_samples VALUES (?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
@@ -169,6 +237,7 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
 
 void TraceFile::record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoint>& endpoints) {
     if (endpoints.empty()) return;
+    sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO discovery VALUES (?, ?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {
@@ -193,6 +262,7 @@ void TraceFile::record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoin
 }
 
 void TraceFile::record_deposition(const emulators::DepositionGrid& grid) {
+    sync();
     const auto& params = grid.params();
     set_meta("deposition_grid", nlohmann::json{{"first_row_centre_m", grid.row_centre_m(0)},
                                                {"cell_along_m", params.cell_along_m},
@@ -234,6 +304,7 @@ void TraceFile::record_deposition(const emulators::DepositionGrid& grid) {
 }
 
 void TraceFile::record_landing_edges(const std::vector<emulators::LandingEdge>& edges) {
+    sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO landing_edges VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
         throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
@@ -256,6 +327,8 @@ void TraceFile::record_landing_edges(const std::vector<emulators::LandingEdge>& 
 
 std::string TraceFile::finish(const TraceOutcome& outcome) {
     if (db_ == nullptr) return sha256_;
+    sync();
+    stop_writer();
     if (digest_text_.empty()) {
         unsigned char hash[EVP_MAX_MD_SIZE];
         unsigned int length = 0;

@@ -17,9 +17,20 @@
 // Rows are committed in batches as they come (write-ahead log), so a rig killed
 // mid-run leaves a readable file up to the last batch; finish() writes the
 // outcome and the digest into meta and folds the log back into the one file.
+//
+// Samples are written off the lockstep round's critical path: append() queues
+// the row and a writer thread of the file's own serializes it, digests it and
+// inserts it, in the order queued (so the digest is the same). Every other call
+// first waits for the queue to drain, so the file is only ever touched by one
+// thread at a time; all calls come from the thread that runs the case. A write
+// that fails (a full disk) is reported by the next call, naming the file.
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -73,8 +84,19 @@ public:
     TimeNs last_t_ns() const { return last_t_ns_; }
 
 private:
+    struct PendingRow {
+        TimeNs t = 0;
+        int round = 0;
+        std::string topic;
+        nlohmann::json json;
+    };
     void exec(const char* sql);
     void digest(const std::string& canonical);
+    void write_row(const PendingRow& row);  // on the writer thread
+    void writer_loop();
+    // Until every queued row is written; throws the writer's error, if any.
+    void sync();
+    void stop_writer() noexcept;
 
     std::filesystem::path file_;
     sqlite3* db_ = nullptr;
@@ -85,6 +107,17 @@ private:
     TimeNs last_t_ns_ = 0;
     std::string digest_text_;  // the digest, once computed (finish may be retried)
     std::string sha256_;       // set once the file is closed
+
+    // The writer thread and its queue (bounded: a slow disk slows the run down
+    // rather than filling memory).
+    std::mutex queue_mutex_;
+    std::condition_variable queued_;   // rows to write, or stop
+    std::condition_variable drained_;  // the queue emptied, or room in it
+    std::deque<PendingRow> queue_;
+    bool writing_ = false;             // the writer holds rows taken off the queue
+    bool stopping_ = false;
+    std::string writer_error_;
+    std::thread writer_;
 };
 
 }  // namespace rig::harness
