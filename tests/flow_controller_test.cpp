@@ -435,13 +435,18 @@ private:
             pulses_ = pulses;
             last_edge_us_ = static_cast<std::uint32_t>(now_ / 1000);
         }
+        // Land wheel: 1000 pulses per revolution of a 1 m wheel (Eq. 5), no slip;
+        // its capture timer, like the meter's, holding the millisecond of the last edge.
+        const double odometer_m = plant_.vehicle().state_at(rig::ns_to_seconds(now_)).odometer_distance_m;
+        const auto wheel_pulses =
+            static_cast<std::uint32_t>(odometer_m / (M_PI * config_.wheel_diameter_m) * config_.pulses_per_rev);
+        if (wheel_pulses != wheel_pulses_) {
+            wheel_pulses_ = wheel_pulses;
+            wheel_edge_us_ = static_cast<std::uint32_t>(now_ / 1000);
+        }
         if (now_ % (10 * kMs) == 0) {
             controller_.on_flow_meter_count(pulses_, last_edge_us_, now_);
-            // Land wheel: 1000 pulses per revolution of a 1 m wheel (Eq. 5), no slip.
-            const double odometer_m = plant_.vehicle().state_at(rig::ns_to_seconds(now_)).odometer_distance_m;
-            controller_.on_encoder_count(static_cast<std::uint32_t>(odometer_m / (M_PI * config_.wheel_diameter_m) *
-                                                                    config_.pulses_per_rev),
-                                         now_);
+            controller_.on_encoder_count(wheel_pulses_, wheel_edge_us_, now_);
         }
         if (now_ % (50 * kMs) == 0) {
             controller_.on_pump_sensor_voltage(pump_sensor_.voltage_for(circuit_.pump_flow_l_min()), now_);
@@ -495,6 +500,8 @@ private:
     TimeNs now_ = 0;
     std::uint32_t pulses_ = 0;
     std::uint32_t last_edge_us_ = 0;
+    std::uint32_t wheel_pulses_ = 0;
+    std::uint32_t wheel_edge_us_ = 0;
     bool nmea_on_ = false;
     std::uint32_t both_relays_seen_ = 0;
     std::vector<std::pair<TimeNs, rig::msg::SprayPhase>> phases_;
