@@ -291,7 +291,7 @@ std::vector<TcpHostileRow> tcp_hostile_rows() {
         {"function code 0x80 (an exception code as a request)", frame({0x80}), Outcome::exception, 0x80,
          E::illegal_function},
         // --- addresses
-        {"read input register 9 (table is 0..8)", frame({0x04, 0x00, 0x09, 0x00, 0x01}), Outcome::exception, 0x04,
+        {"read input register 11 (table is 0..10)", frame({0x04, 0x00, 0x0B, 0x00, 0x01}), Outcome::exception, 0x04,
          E::illegal_data_address},
         {"read coils 65535.. (address + quantity past 16 bits)", frame({0x01, 0xFF, 0xFF, 0x00, 0x10}),
          Outcome::exception, 0x01, E::illegal_data_address},
@@ -521,7 +521,7 @@ TEST_F(ModbusSlaveRtu, UnknownFunctionGetsIllegalFunction) {
     mt::RawSerial line(pair_->master_end());
     EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x2B, 0x0E, 0x01, 0x00}), 5),
               frame_rtu(1, Bytes{0xAB, 0x01}));
-    EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x04, 0x00, 0x09, 0x00, 0x01}), 5),
+    EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x04, 0x00, 0x0B, 0x00, 0x01}), 5),
               frame_rtu(1, Bytes{0x84, 0x02}));
     EXPECT_GE(slave_->statistics().illegal_function, 1u);
 }
