@@ -121,7 +121,7 @@ void check_exceptions(const MbpollPeer& peer, const ModbusSlave& slave) {
     const mt::CommandResult reserved = peer.mbpoll("-t 0 -r 4", "1");
     EXPECT_NE(reserved.exit_code, 0);
     EXPECT_NE(reserved.output.find("Illegal data value"), std::string::npos) << reserved.output;
-    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 9 -c 1");
+    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 11 -c 1");
     EXPECT_NE(outside.exit_code, 0);
     EXPECT_NE(outside.output.find("Illegal data address"), std::string::npos) << outside.output;
     const auto after = slave.statistics();

@@ -661,7 +661,7 @@ TEST(ModbusMasterErrors, SilentEndpointTimesOutInBoundedTime) {
         EXPECT_LT(clock.elapsed(), kGenerous);
         EXPECT_EQ(error.kind(), ModbusMasterError::Kind::timeout);
         EXPECT_EQ(std::string(error.what()), "Modbus master tcp 127.0.0.1:" + std::to_string(silent.port()) +
-                                                 " unit 1: read input registers 0..8 (FC 04): no response within 300 ms "
+                                                 " unit 1: read input registers 0..10 (FC 04): no response within 300 ms "
                                                  "(timeout)");
     }
 }
@@ -682,15 +682,17 @@ TEST(ModbusMasterErrors, ExceptionResponseIsNamed) {
 }
 
 TEST(ModbusMasterErrors, OtherMapVersionIsRefused) {
-    // A slave that says map version 3 in register 6 of its 9-register answer.
-    ScriptedTcpSlave scripted(
-        [](const Bytes&) { return Bytes{0x04, 18, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0}; });
+    // A slave that says map version 2 (no encoder capture) in register 6 of an
+    // 11-register answer: this master speaks 3 and refuses it.
+    ScriptedTcpSlave scripted([](const Bytes&) {
+        return Bytes{0x04, 22, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0};
+    });
     TcpMasterOptions options;
     options.slave.port = scripted.port();
     ModbusMaster master(options, patient());
     const ModbusMasterError error = master_error_of([&] { master.read_device_signals(); });
     EXPECT_EQ(error.kind(), ModbusMasterError::Kind::map_mismatch);
-    EXPECT_NE(std::string(error.what()).find("slave serves register map version 3, this master speaks version 2"),
+    EXPECT_NE(std::string(error.what()).find("slave serves register map version 2, this master speaks version 3"),
               std::string::npos);
 }
 
