@@ -68,7 +68,9 @@ TimeNs ReferenceController::step(TimeNs now_ns) {
     }
     // Fixed order (encoder, meters, sensors, GNSS, panel) keeps runs identical
     // whatever the arrival order across topics.
-    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) firmware_.on_encoder_count(sample.count_pulses(), now_ns);
+    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) {
+        firmware_.on_encoder_count(sample.count_pulses(), sample.last_edge_capture_us(), now_ns);
+    }
     for (const auto& sample : device_inputs_->main_flow_meter.take_all()) {
         firmware_.on_flow_meter_count(sample.count_pulses(), sample.last_edge_capture_us(), now_ns);
     }

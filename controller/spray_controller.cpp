@@ -72,7 +72,7 @@ void SprayController::handle_fix_complete(TimeNs now_ns) {
     last_fix_complete_ns_ = now_ns;
     // TEST-ONLY fault: every fix re-anchors the odometer, stale or not.
     if (config_.faults.stale_fix_reanchor) locator_.release_odometer();
-    on_locator_event(locator_.on_fix(*last_fix_, latest_count_, speed_m_s()), now_ns);
+    on_locator_event(locator_.on_fix(*last_fix_, latest_encoder_, speed_m_s(), now_ns), now_ns);
 }
 
 TimeNs SprayController::refeed_stale_fix(TimeNs now_ns) {
@@ -91,14 +91,30 @@ TimeNs SprayController::refeed_stale_fix(TimeNs now_ns) {
     return next_stale_fix_ns_;
 }
 
-void SprayController::on_encoder_count(std::uint32_t count_pulses, TimeNs now_ns) {
-    latest_count_ = count_pulses;
-    encoder_window_.emplace_back(now_ns, count_pulses);
+void SprayController::on_encoder_count(std::uint32_t count_pulses, std::optional<std::uint32_t> last_edge_capture_us,
+                                       TimeNs now_ns) {
+    EncoderReading reading{count_pulses, std::nullopt};
+    if (last_edge_capture_us) {
+        // The capture timer runs on the board's clock, whose microseconds now_ns
+        // counts: the edge's age is an unsigned difference, right across the
+        // timer's 32-bit wrap. An edge "after" the read (the top half of the wrap)
+        // is a wire out of step with this clock: taken as read now.
+        const TimeNs now_us = now_ns / 1000;
+        const std::uint32_t age_us = static_cast<std::uint32_t>(static_cast<std::uint32_t>(now_us) - *last_edge_capture_us);
+        reading.last_edge_ns = (age_us < 0x80000000u ? now_us - static_cast<TimeNs>(age_us) : now_us) * 1000;
+    }
+    // Read times and capture times are two time lines: a wire that switches
+    // between them starts the speed window over rather than mixing them.
+    if (latest_encoder_ && latest_encoder_->last_edge_ns.has_value() != reading.last_edge_ns.has_value()) {
+        encoder_window_.clear();
+    }
+    latest_encoder_ = reading;
+    encoder_window_.push_back(EncoderRead{now_ns, reading.last_edge_ns.value_or(now_ns), count_pulses});
     const TimeNs window_ns = seconds_to_ns(config_.speed_window_s);
-    while (encoder_window_.size() > 2 && encoder_window_.front().first < now_ns - window_ns) {
+    while (encoder_window_.size() > 2 && encoder_window_.front().read_ns < now_ns - window_ns) {
         encoder_window_.pop_front();
     }
-    on_locator_event(locator_.on_encoder(count_pulses), now_ns);
+    on_locator_event(locator_.on_encoder(reading, speed_m_s(), now_ns), now_ns);
 }
 
 void SprayController::on_flow_meter_count(std::uint32_t count_pulses,
@@ -214,11 +230,13 @@ void SprayController::publish_event(msg::BreakpointEventKind kind, const StoredB
 
 double SprayController::speed_m_s() const {
     if (encoder_window_.size() < 2) return 0.0;
-    const auto& [t0, c0] = encoder_window_.front();
-    const auto& [t1, c1] = encoder_window_.back();
-    if (t1 <= t0) return 0.0;
+    const EncoderRead& first = encoder_window_.front();
+    const EncoderRead& last = encoder_window_.back();
+    // Standing (no edge within the window, so both reads hold the same edge): 0.
+    if (last.timed_ns <= first.timed_ns) return 0.0;
     // Eq. 5 gives km/h; the controller works in m/s internally.
-    return speed_km_h_from_pulses(config_.wheel_diameter_m, c1 - c0, config_.pulses_per_rev, ns_to_seconds(t1 - t0)) /
+    return speed_km_h_from_pulses(config_.wheel_diameter_m, last.count - first.count, config_.pulses_per_rev,
+                                  ns_to_seconds(last.timed_ns - first.timed_ns)) /
            3.6;
 }
 
@@ -288,17 +306,24 @@ TimeNs SprayController::apply_section_chatter(TimeNs now_ns) {
     return now_ns - into_ns + (dropped ? closed_ns : period_ns);  // the next edge of the chatter
 }
 
-bool SprayController::continuation_open_point_reached() const {
-    const std::optional<double> to_go_m = locator_.nozzle_to_breakpoint_m();
-    if (!to_go_m) return false;
+double SprayController::continuation_lead_m() const {
     // Eq. 7: s = s_b + L4 - v (t2 + t3); with the odometer's s, the nozzle line's
     // distance still to go (s_b + L4 - s) must have come down to v (t2 + t3).
     const double lead_m = config_.hysteresis_compensation
                               ? speed_m_s() * (config_.assumed_flow_adjust_s + config_.assumed_spray_delay_s)
                               : 0.0;
-    // TEST-ONLY faults: a wrong lead, or no continuation at all.
+    return lead_m * config_.faults.lead_scale;  // TEST-ONLY fault: a wrong lead
+}
+
+bool SprayController::continuation_open_point_reached(TimeNs now_ns) const {
+    // TEST-ONLY fault: no continuation at all.
     if (config_.faults.never_resume) return false;
-    return *to_go_m <= lead_m * config_.faults.lead_scale;
+    const std::optional<double> to_go_m = locator_.nozzle_to_breakpoint_m_at(now_ns);
+    if (!to_go_m) return false;
+    const double lead_m = continuation_lead_m();
+    // Or the instant predicted from the last edge has come (update() woke for it).
+    const std::optional<TimeNs> open_ns = locator_.instant_nozzle_to_go_m(lead_m);
+    return *to_go_m <= lead_m || (open_ns && *open_ns <= now_ns);
 }
 
 void SprayController::regulate(TimeNs now_ns) {
@@ -344,6 +369,8 @@ void SprayController::regulate(TimeNs now_ns) {
 }
 
 TimeNs SprayController::update(TimeNs now_ns) {
+    // The odometer's predicted instant at the breakpoint (a timer compare).
+    on_locator_event(locator_.on_time(now_ns), now_ns);
     valve_.update(now_ns);
     const bool pid_due = now_ns >= next_pid_ns_;
     if (pid_due) next_pid_ns_ = next_period_boundary(now_ns, seconds_to_ns(config_.pid_period_s));
@@ -390,7 +417,7 @@ TimeNs SprayController::update(TimeNs now_ns) {
                 command_valve(valve_command_pct_, now_ns);
                 pid_.reset();
             }
-            if (continuation_open_point_reached()) {
+            if (continuation_open_point_reached(now_ns)) {
                 // Open even if the valve is not there yet: late is better than never.
                 continuing_ = true;
                 continuation_on_target_ = false;
@@ -408,6 +435,13 @@ TimeNs SprayController::update(TimeNs now_ns) {
     next = std::min(next, valve_.next_event_ns());
     next = std::min(next, apply_section_chatter(now_ns));
     next = std::min(next, refeed_stale_fix(now_ns));
+    // Act at the instants the odometer predicts from its last edge, not at the
+    // next read: the breakpoint, and the continuation's open point.
+    next = std::min(next, locator_.next_compare_ns());
+    if (phase_ == msg::SPRAY_APPROACH && !config_.faults.never_resume) {
+        const std::optional<TimeNs> open_ns = locator_.instant_nozzle_to_go_m(continuation_lead_m());
+        if (open_ns && *open_ns > now_ns) next = std::min(next, *open_ns);
+    }
     return next;
 }
 
@@ -440,7 +474,7 @@ msg::ControllerStatus SprayController::status(TimeNs now_ns) const {
     status.positioning_mode(config_.positioning == Positioning::fusion ? msg::RTK_ODOMETER_FUSION : msg::RTK_ONLY);
     status.breakpoint_pending(locator_.target().has_value());
     status.odometer_active(locator_.odometer_active());
-    status.nozzle_to_breakpoint_m(locator_.nozzle_to_breakpoint_m().value_or(kNaN));
+    status.nozzle_to_breakpoint_m(locator_.nozzle_to_breakpoint_m_at(now_ns).value_or(kNaN));
     status.speed_km_h(speed_m_s() * 3.6);
     status.l4_m(locator_.l4_m());
     status.gnss_fix_quality(static_cast<std::uint16_t>(last_quality_));

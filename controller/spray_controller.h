@@ -60,7 +60,10 @@ public:
 
     // ---- inputs, each with the instant it was read
     void on_nmea_sentence(const std::string& line, TimeNs now_ns);
-    void on_encoder_count(std::uint32_t count_pulses, TimeNs now_ns);
+    // The encoder's capture timer value at the last counted edge (1 MHz, 32 bit,
+    // the board's clock: now_ns's microseconds) when the wire carries it.
+    void on_encoder_count(std::uint32_t count_pulses, std::optional<std::uint32_t> last_edge_capture_us,
+                          TimeNs now_ns);
     // The capture timer value at the last edge (1 MHz) when the wire carries it.
     void on_flow_meter_count(std::uint32_t count_pulses, std::optional<std::uint32_t> last_edge_capture_us,
                              TimeNs now_ns);
@@ -109,7 +112,9 @@ private:
     TimeNs apply_section_chatter(TimeNs now_ns);
     TimeNs refeed_stale_fix(TimeNs now_ns);
     void regulate(TimeNs now_ns);
-    bool continuation_open_point_reached() const;
+    bool continuation_open_point_reached(TimeNs now_ns) const;
+    // The lead of Eq. 7, v (t2 + t3), at which the continuation opens.
+    double continuation_lead_m() const;
 
     ControllerConfig config_;
     BreakpointStore store_;
@@ -127,9 +132,16 @@ private:
     int last_quality_ = 0;
     std::uint32_t rejected_sentences_ = 0;
 
-    // Encoder samples within the Eq. 5 speed window: (time, count).
-    std::deque<std::pair<TimeNs, std::uint32_t>> encoder_window_;
-    std::optional<std::uint32_t> latest_count_;
+    // Encoder reads within the Eq. 5 speed window, by read time. With a capture
+    // time Eq. 5 is timed edge to edge (t1 between the edges' captures), as the
+    // flow meter's Eq. 3; without, from read to read.
+    struct EncoderRead {
+        TimeNs read_ns;
+        TimeNs timed_ns;   // the last edge's capture, or the read time without one
+        std::uint32_t count;
+    };
+    std::deque<EncoderRead> encoder_window_;
+    std::optional<EncoderReading> latest_encoder_;
     bool button_closed_ = false;
     bool spray_switch_on_ = false;
     std::optional<double> pump_flow_l_min_;

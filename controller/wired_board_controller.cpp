@@ -66,7 +66,7 @@ void WiredBoardController::read_nmea(TimeNs now_ns) {
 
 void WiredBoardController::poll_board(TimeNs now_ns) {
     const io::DeviceSignals inputs = with_retries([&] { return board_->read_device_signals(); });
-    firmware_.on_encoder_count(inputs.wheel_encoder_count, now_ns);
+    firmware_.on_encoder_count(inputs.wheel_encoder_count, inputs.wheel_encoder_last_edge_us, now_ns);
     firmware_.on_flow_meter_count(inputs.main_flow_pulses, inputs.main_flow_last_edge_us, now_ns);
     firmware_.on_pump_sensor_voltage(io::voltage_from_adc_counts(inputs.pump_flow_adc), now_ns);
     firmware_.on_boom_height_voltage(io::voltage_from_adc_counts(inputs.boom_height_adc), now_ns);

@@ -33,6 +33,10 @@ msg::VehicleTruth Plant::truth_at(TimeNs t) const {
     return truth;
 }
 
+double Plant::wheel_travel_m_at(TimeNs t) const {
+    return wheel_.wheel_travel_m(vehicle_.state_at(ns_to_seconds(t)).odometer_distance_m);
+}
+
 PlantNode::PlantNode(const Plant& plant, double truth_rate_hz)
     : plant_(plant), period_ns_(seconds_to_ns(1.0 / truth_rate_hz)) {}
 

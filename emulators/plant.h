@@ -37,6 +37,8 @@ public:
     const LandWheel& land_wheel() const { return wheel_; }
     // Complete truth at time t (a pure function of t and the seed).
     msg::VehicleTruth truth_at(TimeNs t) const;
+    // truth_at(t).wheel_travel_m() alone, for emulators that search in time.
+    double wheel_travel_m_at(TimeNs t) const;
 
 private:
     PlantParams params_;

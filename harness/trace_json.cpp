@@ -30,7 +30,9 @@ nlohmann::json to_json(const msg::NmeaSentence& sample) {
     return {{"sentence", text}};
 }
 
-nlohmann::json to_json(const msg::EncoderCount& sample) { return {{"count_pulses", sample.count_pulses()}}; }
+nlohmann::json to_json(const msg::EncoderCount& sample) {
+    return {{"count_pulses", sample.count_pulses()}, {"last_edge_capture_us", sample.last_edge_capture_us()}};
+}
 
 nlohmann::json to_json(const msg::FlowMeterCount& sample) {
     return {{"count_pulses", sample.count_pulses()}, {"last_edge_capture_us", sample.last_edge_capture_us()}};

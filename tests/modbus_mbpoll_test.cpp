@@ -40,6 +40,7 @@ io::DeviceSignals served_signals() {
     io::DeviceSignals signals;
     signals.wheel_encoder_count = 0x12345678;  // registers 0x1234, 0x5678
     signals.main_flow_pulses = 123456;         // registers 0x0001, 0xE240
+    signals.wheel_encoder_last_edge_us = 70000;  // registers 0x0001, 0x1170
     signals.pump_flow_adc = 2048;
     signals.boom_height_adc = 310;
     signals.breakpoint_button = false;
@@ -61,11 +62,11 @@ public:
 };
 
 void check_reads(const MbpollPeer& peer) {
-    const mt::CommandResult registers = peer.mbpoll("-t 3 -r 0 -c 9");
+    const mt::CommandResult registers = peer.mbpoll("-t 3 -r 0 -c 11");
     ASSERT_EQ(registers.exit_code, 0) << registers.output;
     const std::map<int, long long> expected{{0, 0x1234}, {1, 0x5678}, {2, 0x0001}, {3, 0xE240},
                                             {4, 2048},   {5, 310},    {6, kRegisterMapVersion},
-                                            {7, 0},      {8, 0}};
+                                            {7, 0},      {8, 0},      {9, 0x0001}, {10, 0x1170}};
     EXPECT_EQ(printed_values(registers.output), expected) << registers.output;
 
     const mt::CommandResult counters = peer.mbpoll("-t 3:int -B -r 0 -c 2");
@@ -120,7 +121,7 @@ void check_exceptions(const MbpollPeer& peer, const ModbusSlave& slave) {
     const mt::CommandResult reserved = peer.mbpoll("-t 0 -r 4", "1");
     EXPECT_NE(reserved.exit_code, 0);
     EXPECT_NE(reserved.output.find("Illegal data value"), std::string::npos) << reserved.output;
-    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 9 -c 1");
+    const mt::CommandResult outside = peer.mbpoll("-t 3 -r 11 -c 1");
     EXPECT_NE(outside.exit_code, 0);
     EXPECT_NE(outside.output.find("Illegal data address"), std::string::npos) << outside.output;
     const auto after = slave.statistics();

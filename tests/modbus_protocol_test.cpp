@@ -73,11 +73,12 @@ bool same_image(const RegisterImage& a, const RegisterImage& b) {
 
 TEST(ModbusServe, ReadInputRegistersAllInOne) {
     RegisterImage image = sample_image();
-    const ServedRequest served = serve_request(request(0x04, 0, 9), image);
+    const ServedRequest served = serve_request(request(0x04, 0, 11), image);
     EXPECT_FALSE(served.exception);
-    // ..., map version 2, then the flow meter's capture time (registers 7-8, zero in the sample).
-    EXPECT_EQ(served.response_pdu, (Bytes{0x04, 18, 0x00, 0x01, 0x23, 0x45, 0xAB, 0xCD, 0x00, 0x01, 0x04, 0xD2, 0x0F,
-                                          0xFF, 0x00, 0x02, 0x00, 0x00, 0x00, 0x00}));
+    // ..., map version 3, then the flow meter's and the encoder's capture times
+    // (registers 7-8 and 9-10, zero in the sample).
+    EXPECT_EQ(served.response_pdu, (Bytes{0x04, 22, 0x00, 0x01, 0x23, 0x45, 0xAB, 0xCD, 0x00, 0x01, 0x04, 0xD2, 0x0F,
+                                          0xFF, 0x00, 0x03, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}));
     EXPECT_FALSE(served.wrote_outputs);
 }
 
@@ -191,8 +192,8 @@ std::vector<HostileRow> hostile_rows() {
         {request(0x02, 0, 3), E::illegal_data_address, "read discrete inputs 0..2"},
         {request(0x03, 3, 1), E::illegal_data_address, "read holding register 3"},
         {request(0x03, 0xFFFF, 1), E::illegal_data_address, "read holding register 65535"},
-        {request(0x04, 9, 1), E::illegal_data_address, "read input register 9"},
-        {request(0x04, 0, 10), E::illegal_data_address, "read input registers 0..9"},
+        {request(0x04, 11, 1), E::illegal_data_address, "read input register 11"},
+        {request(0x04, 0, 12), E::illegal_data_address, "read input registers 0..11"},
         {request(0x04, 100, 125), E::illegal_data_address, "read input registers far out, maximum quantity"},
         {request(0x05, 16, 0xFF00), E::illegal_data_address, "write coil 16"},
         {request(0x05, 0xFFFF, 0x0000), E::illegal_data_address, "write coil 65535"},
@@ -241,7 +242,7 @@ TEST(ModbusServe, EmptyPduGetsNoResponse) {
 
 TEST(ModbusServe, ProblemTextsNameWhatAndWhere) {
     RegisterImage image = sample_image();
-    EXPECT_EQ(serve_request(request(0x04, 7, 3), image).problem, "FC 04: input registers 7..9 outside 0..8");
+    EXPECT_EQ(serve_request(request(0x04, 9, 3), image).problem, "FC 04: input registers 9..11 outside 0..10");
     EXPECT_EQ(serve_request(request(0x03, 0, 0), image).problem, "FC 03: quantity 0 outside 1..125");
     EXPECT_EQ(serve_request(request(0x05, 1, 0x1234), image).problem,
               "FC 05: coil value 0x1234 is neither 0x0000 (off) nor 0xFF00 (on)");

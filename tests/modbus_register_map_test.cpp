@@ -30,6 +30,8 @@ io::DeviceSignals signals_with(std::uint32_t wheel, std::uint32_t flow, std::uin
 void expect_same(const io::DeviceSignals& a, const io::DeviceSignals& b) {
     EXPECT_EQ(a.wheel_encoder_count, b.wheel_encoder_count);
     EXPECT_EQ(a.main_flow_pulses, b.main_flow_pulses);
+    EXPECT_EQ(a.main_flow_last_edge_us, b.main_flow_last_edge_us);
+    EXPECT_EQ(a.wheel_encoder_last_edge_us, b.wheel_encoder_last_edge_us);
     EXPECT_EQ(a.pump_flow_adc, b.pump_flow_adc);
     EXPECT_EQ(a.boom_height_adc, b.boom_height_adc);
     EXPECT_EQ(a.breakpoint_button, b.breakpoint_button);
@@ -37,7 +39,10 @@ void expect_same(const io::DeviceSignals& a, const io::DeviceSignals& b) {
 }
 
 TEST(ModbusRegisterMap, WordOrderIsHighWordFirst) {
-    const InputRegisters registers = encode_input_registers(signals_with(0x12345678u, 0xCAFEF00Du, 4095, 17, false, true));
+    io::DeviceSignals signals = signals_with(0x12345678u, 0xCAFEF00Du, 4095, 17, false, true);
+    signals.main_flow_last_edge_us = 0x0BADBEEFu;
+    signals.wheel_encoder_last_edge_us = 0xFEEDC0DEu;
+    const InputRegisters registers = encode_input_registers(signals);
     EXPECT_EQ(registers[0], 0x1234);
     EXPECT_EQ(registers[1], 0x5678);
     EXPECT_EQ(registers[2], 0xCAFE);
@@ -45,7 +50,13 @@ TEST(ModbusRegisterMap, WordOrderIsHighWordFirst) {
     EXPECT_EQ(registers[4], 4095);
     EXPECT_EQ(registers[5], 17);
     EXPECT_EQ(registers[6], kRegisterMapVersion);
-    EXPECT_EQ(map_version_of(registers), 2);
+    EXPECT_EQ(map_version_of(registers), 3);
+    // Version 2's flow-meter capture, then version 3's encoder capture.
+    EXPECT_EQ(registers[7], 0x0BAD);
+    EXPECT_EQ(registers[8], 0xBEEF);
+    EXPECT_EQ(registers[9], 0xFEED);
+    EXPECT_EQ(registers[10], 0xC0DE);
+    EXPECT_EQ(registers.size(), 11u);
 }
 
 TEST(ModbusRegisterMap, DeviceSignalsRoundTrip) {
@@ -55,8 +66,11 @@ TEST(ModbusRegisterMap, DeviceSignalsRoundTrip) {
         for (std::uint32_t flow : counts) {
             for (std::uint16_t adc : adcs) {
                 for (int bits = 0; bits < 4; ++bits) {
-                    const auto original = signals_with(wheel, flow, adc, static_cast<std::uint16_t>(4095 - adc),
-                                                       (bits & 1) != 0, (bits & 2) != 0);
+                    auto original = signals_with(wheel, flow, adc, static_cast<std::uint16_t>(4095 - adc),
+                                                 (bits & 1) != 0, (bits & 2) != 0);
+                    // The capture times (uint32 like the counts): the counts swapped round.
+                    original.main_flow_last_edge_us = wheel;
+                    original.wheel_encoder_last_edge_us = flow;
                     RegisterImage image;
                     encode_device_signals(original, image);
                     expect_same(decode_device_signals(image.input_registers, image.discrete_inputs), original);
@@ -187,7 +201,9 @@ TEST(ModbusRegisterMap, NamesForMessages) {
     EXPECT_EQ(input_register_name(0), "wheel_encoder_count (high word)");
     EXPECT_EQ(input_register_name(6), "map_version");
     EXPECT_EQ(input_register_name(7), "main_flow_last_edge_us (high word)");
-    EXPECT_EQ(input_register_name(9), "unmapped");
+    EXPECT_EQ(input_register_name(9), "wheel_encoder_last_edge_us (high word)");
+    EXPECT_EQ(input_register_name(10), "wheel_encoder_last_edge_us (low word)");
+    EXPECT_EQ(input_register_name(11), "unmapped");
     EXPECT_EQ(holding_register_name(2), "indicator_flags");
     EXPECT_EQ(holding_register_name(3), "unmapped");
 }

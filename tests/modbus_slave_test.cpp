@@ -291,7 +291,7 @@ std::vector<TcpHostileRow> tcp_hostile_rows() {
         {"function code 0x80 (an exception code as a request)", frame({0x80}), Outcome::exception, 0x80,
          E::illegal_function},
         // --- addresses
-        {"read input register 9 (table is 0..8)", frame({0x04, 0x00, 0x09, 0x00, 0x01}), Outcome::exception, 0x04,
+        {"read input register 11 (table is 0..10)", frame({0x04, 0x00, 0x0B, 0x00, 0x01}), Outcome::exception, 0x04,
          E::illegal_data_address},
         {"read coils 65535.. (address + quantity past 16 bits)", frame({0x01, 0xFF, 0xFF, 0x00, 0x10}),
          Outcome::exception, 0x01, E::illegal_data_address},
@@ -521,7 +521,7 @@ TEST_F(ModbusSlaveRtu, UnknownFunctionGetsIllegalFunction) {
     mt::RawSerial line(pair_->master_end());
     EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x2B, 0x0E, 0x01, 0x00}), 5),
               frame_rtu(1, Bytes{0xAB, 0x01}));
-    EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x04, 0x00, 0x09, 0x00, 0x01}), 5),
+    EXPECT_EQ(ask_until_answered(line, frame_rtu(1, Bytes{0x04, 0x00, 0x0B, 0x00, 0x01}), 5),
               frame_rtu(1, Bytes{0x84, 0x02}));
     EXPECT_GE(slave_->statistics().illegal_function, 1u);
 }
@@ -661,7 +661,7 @@ TEST(ModbusMasterErrors, SilentEndpointTimesOutInBoundedTime) {
         EXPECT_LT(clock.elapsed(), kGenerous);
         EXPECT_EQ(error.kind(), ModbusMasterError::Kind::timeout);
         EXPECT_EQ(std::string(error.what()), "Modbus master tcp 127.0.0.1:" + std::to_string(silent.port()) +
-                                                 " unit 1: read input registers 0..8 (FC 04): no response within 300 ms "
+                                                 " unit 1: read input registers 0..10 (FC 04): no response within 300 ms "
                                                  "(timeout)");
     }
 }
@@ -682,15 +682,17 @@ TEST(ModbusMasterErrors, ExceptionResponseIsNamed) {
 }
 
 TEST(ModbusMasterErrors, OtherMapVersionIsRefused) {
-    // A slave that says map version 3 in register 6 of its 9-register answer.
-    ScriptedTcpSlave scripted(
-        [](const Bytes&) { return Bytes{0x04, 18, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0}; });
+    // A slave that says map version 2 (no encoder capture) in register 6 of an
+    // 11-register answer: this master speaks 3 and refuses it.
+    ScriptedTcpSlave scripted([](const Bytes&) {
+        return Bytes{0x04, 22, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0};
+    });
     TcpMasterOptions options;
     options.slave.port = scripted.port();
     ModbusMaster master(options, patient());
     const ModbusMasterError error = master_error_of([&] { master.read_device_signals(); });
     EXPECT_EQ(error.kind(), ModbusMasterError::Kind::map_mismatch);
-    EXPECT_NE(std::string(error.what()).find("slave serves register map version 3, this master speaks version 2"),
+    EXPECT_NE(std::string(error.what()).find("slave serves register map version 2, this master speaks version 3"),
               std::string::npos);
 }
 

@@ -20,6 +20,9 @@ struct DeviceSignals {
     // The frequency input's capture timer (1 MHz, wraps) at the meter's last pulse
     // edge: Eq. 3's t2 measured edge to edge (controller/flow_rate_meter.h).
     std::uint32_t main_flow_last_edge_us = 0;
+    // The counter input's capture timer (the same 1 MHz timer) at the encoder's
+    // last counted edge: where the wheel was between reads (controller/breakpoint_locator.h).
+    std::uint32_t wheel_encoder_last_edge_us = 0;
     std::uint16_t pump_flow_adc = 0;         // pump-outlet sensor, 4-20 mA -> 0-3.3 V -> 12-bit ADC (Eq. 8)
     std::uint16_t boom_height_adc = 0;       // pull-wire boom-height sensor -> 12-bit ADC
     bool breakpoint_button = false;          // breakpoint button on the board, pressed = true

@@ -43,6 +43,8 @@ InputRegisters encode_input_registers(const io::DeviceSignals& signals) {
     registers[kInputMapVersion] = kRegisterMapVersion;
     registers[kInputMainFlowLastEdgeHigh] = high_word(signals.main_flow_last_edge_us);
     registers[kInputMainFlowLastEdgeLow] = low_word(signals.main_flow_last_edge_us);
+    registers[kInputWheelEncoderLastEdgeHigh] = high_word(signals.wheel_encoder_last_edge_us);
+    registers[kInputWheelEncoderLastEdgeLow] = low_word(signals.wheel_encoder_last_edge_us);
     return registers;
 }
 
@@ -68,6 +70,8 @@ io::DeviceSignals decode_device_signals(const InputRegisters& input_registers, c
         join_words(input_registers[kInputMainFlowPulsesHigh], input_registers[kInputMainFlowPulsesLow]);
     signals.main_flow_last_edge_us =
         join_words(input_registers[kInputMainFlowLastEdgeHigh], input_registers[kInputMainFlowLastEdgeLow]);
+    signals.wheel_encoder_last_edge_us =
+        join_words(input_registers[kInputWheelEncoderLastEdgeHigh], input_registers[kInputWheelEncoderLastEdgeLow]);
     signals.pump_flow_adc = input_registers[kInputPumpFlowAdc];
     signals.boom_height_adc = input_registers[kInputBoomHeightAdc];
     signals.breakpoint_button = discrete_inputs[kDiscreteBreakpointButton];
@@ -141,6 +145,8 @@ std::string input_register_name(std::uint16_t address) {
         case kInputMainFlowPulsesLow: return "main_flow_pulses (low word)";
         case kInputMainFlowLastEdgeHigh: return "main_flow_last_edge_us (high word)";
         case kInputMainFlowLastEdgeLow: return "main_flow_last_edge_us (low word)";
+        case kInputWheelEncoderLastEdgeHigh: return "wheel_encoder_last_edge_us (high word)";
+        case kInputWheelEncoderLastEdgeLow: return "wheel_encoder_last_edge_us (low word)";
         case kInputPumpFlowAdc: return "pump_flow_adc";
         case kInputBoomHeightAdc: return "boom_height_adc";
         case kInputMapVersion: return "map_version";

@@ -9,16 +9,19 @@
 // Addresses are PDU addresses (0-based, what goes on the wire). Tools that use
 // 1-based "references" (mbpoll without -0, many HMIs) show address A as A+1.
 //
-// Map version 2 (version 1 had no capture time: registers 7-8 are new)
+// Map version 3 (version 1 had no capture times; 2 added the flow meter's at
+// 7-8, 3 the wheel encoder's at 9-10)
 // | table (FC)                  | addr | name                 | type / range                                  |
 // |-----------------------------|------|----------------------|-----------------------------------------------|
 // | input registers (04)        | 0-1  | wheel_encoder_count  | uint32, high word at 0 (wraps at 2^32)        |
 // |                             | 2-3  | main_flow_pulses     | uint32, high word at 2 (wraps at 2^32)        |
 // |                             | 4    | pump_flow_adc        | 0..4095 (12-bit ADC, Eq. 8)                   |
 // |                             | 5    | boom_height_adc      | 0..4095                                       |
-// |                             | 6    | map_version          | 2 (read it first; a master checks it)         |
+// |                             | 6    | map_version          | 3 (read it first; a master checks it)         |
 // |                             | 7-8  | main_flow_last_edge_us | uint32, high word at 7: the frequency input's |
 // |                             |      |                      | 1 MHz capture timer at the last meter pulse   |
+// |                             | 9-10 | wheel_encoder_last_edge_us | uint32, high word at 9: the same timer at |
+// |                             |      |                      | the encoder's last counted edge               |
 // | discrete inputs (02)        | 0    | breakpoint_button    | 1 = pressed                                   |
 // |                             | 1    | spray_switch         | 1 = on                                        |
 // | coils (01, 05, 15)          | 0    | ball_valve_forward   | relay 1, 1 = energised (towards open)         |
@@ -41,8 +44,9 @@
 //   Coils 3-7 are addressable so that this 16-coil write is legal; they are
 //   reserved and must be written as 0.
 // - The map version sits after the version-1 inputs; version 2 appended the
-//   flow meter's capture time (7-8), so reading 0-8 in one request gets every
-//   input and the version.
+//   flow meter's capture time (7-8), version 3 the encoder's (9-10), so reading
+//   0-10 in one request gets every input and the version. Registers 0-8 mean
+//   what they meant in version 2.
 // - Anything outside the tables is ILLEGAL DATA ADDRESS: a master with a wrong
 //   map learns at once instead of reading zeros.
 #include <array>
@@ -53,7 +57,7 @@
 
 namespace rig::modbus {
 
-inline constexpr std::uint16_t kRegisterMapVersion = 2;
+inline constexpr std::uint16_t kRegisterMapVersion = 3;
 
 // Input registers (FC 04).
 inline constexpr std::uint16_t kInputWheelEncoderCountHigh = 0;
@@ -65,7 +69,9 @@ inline constexpr std::uint16_t kInputBoomHeightAdc = 5;
 inline constexpr std::uint16_t kInputMapVersion = 6;
 inline constexpr std::uint16_t kInputMainFlowLastEdgeHigh = 7;
 inline constexpr std::uint16_t kInputMainFlowLastEdgeLow = 8;
-inline constexpr std::uint16_t kInputRegisterCount = 9;
+inline constexpr std::uint16_t kInputWheelEncoderLastEdgeHigh = 9;
+inline constexpr std::uint16_t kInputWheelEncoderLastEdgeLow = 10;
+inline constexpr std::uint16_t kInputRegisterCount = 11;
 
 // Discrete inputs (FC 02).
 inline constexpr std::uint16_t kDiscreteBreakpointButton = 0;

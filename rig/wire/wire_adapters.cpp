@@ -106,7 +106,10 @@ bool BoardIoAdapter::has_unread_input() const {
 }
 
 void BoardIoAdapter::take_device_topics() {
-    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) signals_.wheel_encoder_count = sample.count_pulses();
+    for (const auto& sample : device_inputs_->wheel_encoder.take_all()) {
+        signals_.wheel_encoder_count = sample.count_pulses();
+        signals_.wheel_encoder_last_edge_us = sample.last_edge_capture_us();
+    }
     for (const auto& sample : device_inputs_->main_flow_meter.take_all()) {
         signals_.main_flow_pulses = sample.count_pulses();
         signals_.main_flow_last_edge_us = sample.last_edge_capture_us();
