@@ -426,6 +426,7 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     result.wall_seconds = run.value("wall_seconds", 0.0);
     result.startup_wall_seconds = run.value("startup_wall_seconds", 0.0);
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());
+    if (run.contains("board_io")) result.board_io = run.at("board_io");
     if (run.contains("emission_jitter")) {
         for (const nlohmann::json& device : run.at("emission_jitter")) {
             EmissionJitter jitter{device.at("device").get<std::string>(), device.at("samples").get<std::size_t>(),
