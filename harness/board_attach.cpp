@@ -89,7 +89,10 @@ nlohmann::json board_scalings_json(const CaseSpec& spec) {
             {"main_flow_pulses_per_l", spec.flow_meter.pulses_per_l},
             {"wheel_encoder_pulses_per_rev", spec.encoder.pulses_per_rev},
             {"wheel_diameter_m", spec.encoder.wheel_diameter_m},
-            {"capture_timer_hz", io::kCaptureTimerHz}};
+            {"capture_timer_hz", io::kCaptureTimerHz},
+            {"valve_travel_s", spec.hydraulics.valve_travel_s},
+            {"valve_motor_start_delay_s", spec.hydraulics.valve_motor_start_delay_s},
+            {"valve_backlash_pct", spec.hydraulics.valve_backlash_pct}};
 }
 
 void announce_attach(const CaseSpec& spec, const BenchWires& wires, const std::string& run_name,
