@@ -427,6 +427,12 @@ ControllerSpec read_controller(const YamlSection& root) {
             }
         }
     }
+    if (section.has("plugin")) {
+        const std::string plugin = section.required<std::string>("plugin");
+        if (plugin.empty() || plugin.size() > 4096) section.fail("plugin", "the path of a controller plugin (.so)");
+        controller.plugin = plugin;
+    }
+    if (section.has("in_process")) controller.in_process = section.required<bool>("in_process");
     // The harness judges flow against the target the controller is given
     // (boom-sprayer pumps deliver at most ~200 L/min; see hydraulics).
     if (section.has("target_flow_l_min")) {
@@ -514,6 +520,18 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     }
     if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
         root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
+    }
+    if (spec.controller.in_process.value_or(false)) {
+        // In process, the controller is stepped by the lockstep master: there is
+        // no process boundary, so no wall clock and no bench wire to drive it.
+        const YamlSection controller(spec.controller.params);
+        if (spec.mode != RunMode::lockstep || spec.wiring.external_controller) {
+            controller.fail("in_process", "a controller runs in process only in lockstep cases on DDS wires");
+        }
+        if (!spec.controller.command.empty() && spec.controller.plugin.empty()) {
+            controller.fail("in_process", "`command` names a program; a controller runs in process from its "
+                                          "shared library: give `plugin` too");
+        }
     }
     if (spec.wiring.board_io == BoardIoWireKind::modbus_tcp) {
         try {

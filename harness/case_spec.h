@@ -242,9 +242,17 @@ struct ControllerSpec {
     // The flow the controller is told to hold (its `target_flow_l_min`, 20 L/min if
     // absent); the harness judges flow against the same number.
     double target_flow_l_min = 20.0;
+    // Software-in-the-loop (rig/runtime/node_plugin.h): `plugin`, the controller
+    // built as a shared library (relative to the case file; empty = the
+    // reference controller's, or none for a `command` without one);
+    // `in_process`, whether to run it in the harness's process (unset: as
+    // `rig run --in-process` says). Lockstep cases on DDS wires only.
+    std::filesystem::path plugin;
+    std::optional<bool> in_process;
 };
-// Keys of the controller section that the rig reads itself.
-inline constexpr std::array<std::string_view, 1> kControllerRigKeys = {"command"};
+// Keys of the controller section that the rig reads itself (not written into
+// the controller's configuration file).
+inline constexpr std::array<std::string_view, 3> kControllerRigKeys = {"command", "plugin", "in_process"};
 
 struct ExpectSpec {
     // Metrics that must break their limits (a negative case): the case passes

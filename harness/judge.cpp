@@ -425,6 +425,8 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     }
     result.wall_seconds = run.value("wall_seconds", 0.0);
     result.startup_wall_seconds = run.value("startup_wall_seconds", 0.0);
+    result.controller_mode = run.value("controller_mode", std::string());
+    result.in_process_refused = run.value("in_process_refused", std::string());
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());
     if (run.contains("board_io")) result.board_io = run.at("board_io");
     if (run.contains("emission_jitter")) {

@@ -105,7 +105,7 @@ void TraceRecorder::drain(TimeNs t, int round) {
         channel.take(taken);
         const bool rig_only = rig_only_topic(channel.topic);
         for (const auto& [json, writer] : taken) {
-            if (rig_only && !dds_.same_process(writer)) {
+            if (rig_only && !dds_.is_rig_participant(writer)) {
                 const std::string participant = dds_.participant_name(writer);
                 file_.append_foreign(t, round, channel.topic, participant, writer, json);
                 foreign_.push_back(ForeignSample{t, channel.topic, participant, writer});
