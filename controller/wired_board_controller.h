@@ -52,7 +52,7 @@ public:
 private:
     void read_nmea(TimeNs now_ns);
     void poll_board(TimeNs now_ns);
-    void write_outputs();
+    void write_outputs(TimeNs now_ns);
     template <class Call>
     auto with_retries(Call call);
 
@@ -64,6 +64,12 @@ private:
     std::string nmea_buffer_;
     std::optional<io::DeviceSignals> last_inputs_;
     std::optional<io::ActuatorCommands> written_actuators_;
+    // When the coils were last written, and the retry count then: they are
+    // written again after a retry and at least every kOutputRefreshNs, since an
+    // I/O module whose comms-loss watchdog tripped (the rig's: board.failsafe)
+    // keeps its outputs de-energised until the master writes them again.
+    TimeNs actuators_written_ns_ = 0;
+    std::uint64_t retries_at_write_ = 0;
     std::optional<io::ControllerIndicators> written_indicators_;
     TimeNs poll_period_ns_;
     TimeNs next_poll_ns_ = 0;

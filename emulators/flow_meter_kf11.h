@@ -18,6 +18,7 @@
 
 #include "emulators/spray_circuit.h"
 #include "rig/runtime/dds_context.h"
+#include "rig/runtime/io_image.h"
 #include "rig/runtime/node.h"
 
 namespace rig::emulators {
@@ -39,7 +40,8 @@ public:
     std::uint32_t count() const { return static_cast<std::uint32_t>(pulses_ & 0xffffffffULL); }
     // Capture timer (1 MHz, wraps) at the last edge.
     std::uint32_t last_edge_capture_us() const {
-        return static_cast<std::uint32_t>(static_cast<std::uint64_t>(last_edge_ns_ / 1000) & 0xffffffffULL);
+        constexpr TimeNs kNsPerTick = 1'000'000'000 / io::kCaptureTimerHz;
+        return static_cast<std::uint32_t>(static_cast<std::uint64_t>(last_edge_ns_ / kNsPerTick) & 0xffffffffULL);
     }
 
 private:

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstring>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <set>
@@ -18,6 +19,7 @@
 #include "emulators/spray_circuit.h"
 #include "emulators/spray_circuit_node.h"
 #include "emulators/wheel_encoder.h"
+#include "harness/board_attach.h"
 #include "harness/boundary_runner.h"
 #include "harness/case_session.h"
 #include "harness/case_world.h"
@@ -90,6 +92,8 @@ struct RunFacts {
     double stepping_wall_seconds = 0.0;
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
+    std::optional<BoardAttachment> board_attachment;  // controller: external
+    nlohmann::json board_io;  // harness/board_attach.h board_io_report(), null without a Modbus wire
 };
 
 std::string describe_signal(int signal) {
@@ -222,9 +226,11 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(session.wires().board_io.get())) {
         modbus_wire->set_wake([&dds] { dds.notify_data_arrived(); });
     }
+    BoardSilenceWatch board_silence(spec, session.wires());
     master.set_after_step([&](TimeNs t) {
         now_ns = t;
         trace.drain(t, 0);
+        board_silence.check(t);
     });
     master.set_watchdog([&watchdog] { watchdog(); });
     master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
@@ -238,6 +244,10 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         }
     };
     try {
+        // A wired board: case time starts once it has attached (harness/board_attach.h).
+        if (spec.wiring.external_controller) {
+            facts.board_attachment = wait_for_board(spec, session.wires(), [&watchdog] { watchdog(); });
+        }
         master.start();
         facts.startup_wall_seconds = wall.elapsed_s();
         master.run_until(end_ns);
@@ -266,15 +276,17 @@ nlohmann::json run_facts_json(const RunFacts& facts, double wall_seconds) {
                           {"step_p99_ms", device.step_p99_ms},
                           {"step_max_ms", device.step_max_ms}});
     }
-    return {{"wall_seconds", wall_seconds},
-            {"controller_mode", facts.controller_mode},
-            {"in_process_refused", facts.in_process_refused},
-            {"startup_wall_seconds", facts.startup_wall_seconds},
-            {"instants", facts.instants},
-            {"rounds", facts.rounds},
-            {"stepping_wall_seconds", facts.stepping_wall_seconds},
-            {"realtime_scheduling", facts.realtime_scheduling},
-            {"emission_jitter", std::move(jitter)}};
+    nlohmann::json run = {{"wall_seconds", wall_seconds},
+                          {"controller_mode", facts.controller_mode},
+                          {"in_process_refused", facts.in_process_refused},
+                          {"startup_wall_seconds", facts.startup_wall_seconds},
+                          {"instants", facts.instants},
+                          {"rounds", facts.rounds},
+                          {"stepping_wall_seconds", facts.stepping_wall_seconds},
+                          {"realtime_scheduling", facts.realtime_scheduling},
+                          {"emission_jitter", std::move(jitter)}};
+    if (!facts.board_io.is_null()) run["board_io"] = facts.board_io;
+    return run;
 }
 
 // A case that could not even start (no trace to judge): its result from what is known.
@@ -372,6 +384,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.file().set_meta("dds_domain", std::to_string(session.domain_id()));
         trace.file().set_meta("harness_guid_prefix", dds.guid_prefix());
         trace.file().set_meta("judging", to_json(plan_judging(spec, world)).dump());
+        if (spec.wiring.external_controller) announce_attach(spec, session.wires(), run_name, case_dir, std::cout);
         trace.set_vehicle_truth_probe([&world](TimeNs t) { return world.plant.truth_at(t); });
         // Nodes hold DDS writers, so they are declared after (and destroyed before) the context.
         LocalNodes nodes(spec, world, circuit, seed, session.wires());
@@ -411,6 +424,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         // Whatever the ending, the spray on the ground so far is part of the record.
         trace.file().record_deposition(circuit.deposition());
         trace.file().record_landing_edges(circuit.landing_edges());
+        facts.board_io = board_io_report(spec, session.wires(), facts.board_attachment);
         trace.file().set_meta("run", run_facts_json(facts, wall.elapsed_s()).dump());
         trace.file().finish(outcome);
     } catch (const std::exception& error) {

@@ -1,5 +1,6 @@
 #include "harness/case_session.h"
 
+#include <cmath>
 #include <fstream>
 
 #include <yaml-cpp/yaml.h>
@@ -37,6 +38,10 @@ std::string log_tail(const std::filesystem::path& log, std::size_t max_lines) {
     return tail;
 }
 
+modbus::CommsFailsafe comms_failsafe(const BoardSpec& board) {
+    return {std::chrono::milliseconds(std::lround(board.failsafe_timeout_s * 1000.0)), board.failsafe};
+}
+
 }  // namespace
 
 BenchWires open_bench_wires(const CaseSpec& spec) {
@@ -68,6 +73,7 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
         case BoardIoWireKind::modbus_rtu: {
             modbus::RtuSlaveOptions options;
             options.line.baud = wiring.modbus_baud;
+            options.failsafe = comms_failsafe(spec.board);
             std::string far_end = wiring.modbus_port;
             if (wiring.modbus_port == "pty") {
                 wires.modbus_link = std::make_unique<PtyLink>();
@@ -77,6 +83,7 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
                 options.line.device = wiring.modbus_port;
             }
             wires.board_io = std::make_unique<ModbusSlaveWire>(options);
+            wires.board_io_far_end = far_end;
             wires.controller_args.insert(wires.controller_args.end(), {"--modbus-rtu", far_end, "--modbus-baud",
                                                                        std::to_string(wiring.modbus_baud)});
             parts.push_back("board_io modbus_rtu " + far_end + " " + std::to_string(wiring.modbus_baud) + " baud");
@@ -87,9 +94,11 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
             const modbus::TcpEndpoint endpoint = modbus::parse_tcp_endpoint(wiring.modbus_tcp);
             options.bind_address = endpoint.address;
             options.port = endpoint.port;
+            options.failsafe = comms_failsafe(spec.board);
             auto wire = std::make_unique<ModbusSlaveWire>(options);
             const std::string address = endpoint.address + ":" + std::to_string(wire->slave().tcp_port());
             wires.controller_args.insert(wires.controller_args.end(), {"--modbus-tcp", address});
+            wires.board_io_far_end = address;
             parts.push_back("board_io modbus_tcp " + address);
             wires.board_io = std::move(wire);
             break;
@@ -98,6 +107,7 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
             // A real bench board; the controller is wired to it, not to the rig process.
             auto transport = HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
             const std::string description = transport->description();
+            wires.board_io_far_end = description;
             wires.board_io = std::make_unique<HidBoardWire>(std::make_unique<HidBoard>(std::move(transport)), description);
             parts.push_back("board_io hid " + description);
             break;

@@ -30,6 +30,7 @@ struct BenchWires {
     std::string gnss_far_end;         // what the controller opens
     std::unique_ptr<PtyLink> modbus_link;
     std::unique_ptr<BoardIoWire> board_io;
+    std::string board_io_far_end;     // what the controller opens: a tty path or ADDRESS:PORT
     std::vector<std::string> controller_args;
     std::string description = "dds";
 };

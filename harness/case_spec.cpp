@@ -715,6 +715,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.deposition = read_deposition(root.section("deposition"));
     spec.static_flow = read_static_flow(root.section("static_flow"));
     spec.wiring = read_wiring(root.section("wiring"));
+    spec.board = read_board_spec(root.section("board"));
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
     spec.expect = read_expect(root.section("expect"));

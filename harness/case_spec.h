@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "harness/board_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
 
@@ -314,6 +315,7 @@ struct CaseSpec {
     DepositionSpec deposition;
     StaticFlowSpec static_flow;
     WiringSpec wiring;
+    BoardSpec board;  // harness/board_spec.h: attach, silence and fail-safe of a wired board
     ControllerSpec controller;
     // Limits as written in the file (metric name -> max allowed value, |v| <= 1e6); the
     // harness judges against effective_limits(), i.e. these over the defaults.

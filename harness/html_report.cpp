@@ -16,6 +16,7 @@
 #include <system_error>
 #include <utility>
 
+#include "harness/board_io_report.h"
 #include "rig/host/child_process.h"
 
 namespace rig::harness {
@@ -1069,6 +1070,15 @@ std::string jitter_table(const std::vector<JitterRow>& jitter) {
     return table + "</table>\n";
 }
 
+// The Modbus board wire's frame counts per kind, fail-safe and attachment.
+std::string board_io_table(const nlohmann::json& board_io) {
+    std::string table = "<table class=\"facts\">\n";
+    for (const auto& [what, value] : board_io_rows(board_io)) {
+        table += "<tr><th>" + html(what) + "</th><td class=\"mono\">" + html(value) + "</td></tr>\n";
+    }
+    return table + "</table>\n";
+}
+
 class PageBuilder {
 public:
     // Adds a panel and returns where its drawing will go in the page.
@@ -1163,6 +1173,7 @@ std::string case_section(PageBuilder& page, std::size_t index, const CaseResult&
         drawn += dose_figure(page, index, result, *figures);
         if (!figures->jitter.empty()) drawn += "<h3>Timing jitter</h3>\n" + jitter_table(figures->jitter);
     }
+    if (!result.board_io.is_null()) drawn += "<h3>Board I/O (Modbus)</h3>\n" + board_io_table(result.board_io);
     if (drawn.empty()) drawn = "<p class=\"muted\">No flow, dose or jitter data was recorded for this case.</p>\n";
     section += drawn;
     section += "<p class=\"nav\"><a href=\"#cases\">\u2191 case table</a></p>\n</section>\n";

@@ -433,6 +433,7 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     result.controller_mode = run.value("controller_mode", std::string());
     result.in_process_refused = run.value("in_process_refused", std::string());
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());
+    if (run.contains("board_io")) result.board_io = run.at("board_io");
     if (run.contains("emission_jitter")) {
         for (const nlohmann::json& device : run.at("emission_jitter")) {
             EmissionJitter jitter{device.at("device").get<std::string>(), device.at("samples").get<std::size_t>(),

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <system_error>
 
+#include "harness/board_io_report.h"
 #include "harness/html_report.h"
 
 namespace rig::harness {
@@ -448,6 +449,7 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             one_case["realtime"] = {{"scheduling", valid_utf8(result.realtime_scheduling)},
                                     {"wiring", valid_utf8(result.wiring)},
                                     {"emission_jitter", std::move(jitter)}};
+            if (!result.board_io.is_null()) one_case["realtime"]["board_io"] = result.board_io;
         }
         cases.push_back(std::move(one_case));
     }
@@ -586,6 +588,7 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
                               device.step_p99_ms, device.step_max_ms);
                 report += line;
             }
+            if (!result.board_io.is_null()) report += "board I/O: " + board_io_summary(result.board_io) + "\n";
         }
     }
     return report;

@@ -54,6 +54,8 @@ struct CaseResult {
     // Real-time runs only: what scheduling the rig got, and the emission jitter per device.
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
+    // A Modbus board wire: frames per kind, fail-safe, attachment (harness/board_attach.h board_io_report).
+    nlohmann::json board_io;
     std::string wiring;                 // e.g. "gnss serial /dev/pts/4, board_io modbus_rtu /dev/pts/6"
 };
 

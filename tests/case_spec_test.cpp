@@ -987,5 +987,32 @@ TEST(YamlSection, ClosestSpelling) {
     EXPECT_EQ(closest_spelling("rtk_fixd", fixes), "rtk_fixed");
 }
 
+// `board:` (harness/board_spec.h): a wired board's attach, silence and fail-safe.
+TEST(CaseSpec, BoardKeysParseWithDefaultsAndBounds) {
+    const CaseSpec defaults = parse_case(std::string(kMinimalCase), "case.yaml");
+    EXPECT_EQ(defaults.board.attach_timeout_s, 60.0);
+    EXPECT_EQ(defaults.board.silence_timeout_s, 2.0);
+    EXPECT_EQ(defaults.board.failsafe_timeout_s, 1.0);
+    EXPECT_EQ(defaults.board.failsafe, rig::modbus::FailsafeMode::safe);
+    const CaseSpec set = parse_case(std::string(kMinimalCase) +
+                                        "board: { attach_timeout_s: 5, silence_timeout_s: 0.5, failsafe_timeout_s: 0, "
+                                        "failsafe: hold }\n",
+                                    "case.yaml");
+    EXPECT_EQ(set.board.attach_timeout_s, 5.0);
+    EXPECT_EQ(set.board.silence_timeout_s, 0.5);
+    EXPECT_EQ(set.board.failsafe_timeout_s, 0.0);
+    EXPECT_EQ(set.board.failsafe, rig::modbus::FailsafeMode::hold);
+    for (const char* bad : {"board: { attach_timeout_s: 0 }\n", "board: { silence_timeout_s: 0.01 }\n",
+                            "board: { failsafe_timeout_s: 0.01 }\n", "board: { failsafe: off }\n",
+                            "board: { watchdog_s: 1 }\n"}) {
+        try {
+            parse_case(std::string(kMinimalCase) + bad, "case.yaml");
+            ADD_FAILURE() << "accepted: " << bad;
+        } catch (const rig::ConfigError& error) {
+            EXPECT_NE(std::string(error.what()).find("board"), std::string::npos) << error.what();
+        }
+    }
+}
+
 }  // namespace
 }  // namespace rig::harness

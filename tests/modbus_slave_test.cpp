@@ -729,3 +729,64 @@ TEST(ModbusMasterErrors, SilentSerialLineTimesOut) {
 
 }  // namespace
 }  // namespace rig::modbus
+
+namespace rig::modbus {
+namespace {
+
+// Waits (bounded far above the fail-safe timeout) until the slave's watchdog has tripped.
+bool wait_for_failsafe(const ModbusSlave& slave) {
+    const RealtimeClock clock;
+    while (!slave.failsafe_active()) {
+        if (clock.now_ns() > seconds_to_ns(10.0)) return false;
+        clock.sleep_until_ns(clock.now_ns() + seconds_to_ns(0.01));
+    }
+    return true;
+}
+
+// The comms-loss watchdog (docs/modbus-register-map.md "External boards"): after
+// the last valid request, `safe` de-energises every coil and tells it like a write;
+// a new request re-arms it without restoring the coils.
+TEST(ModbusSlaveFailsafe, SafeModeDeEnergisesTheCoilsAfterTheLastRequest) {
+    std::atomic<int> commands_changed{0};
+    ModbusSlaveCallbacks callbacks;
+    callbacks.on_master_write = [&](const MasterWrite& write) { commands_changed += write.commands_changed ? 1 : 0; };
+    TcpSlaveOptions options = any_port();
+    options.failsafe = {std::chrono::milliseconds(100), FailsafeMode::safe};
+    ModbusSlave slave(options, callbacks);
+    EXPECT_FALSE(slave.since_last_request().has_value());
+    // Not armed before the first request: a board not yet attached trips nothing.
+    ModbusMaster master(master_for(slave), patient());
+    master.write_actuator_commands(sample_commands());
+    ASSERT_TRUE(slave.since_last_request().has_value());
+    ASSERT_TRUE(wait_for_failsafe(slave));
+    EXPECT_EQ(slave.actuator_commands(), io::ActuatorCommands{});
+    EXPECT_EQ(slave.statistics().failsafe_trips, 1u);
+    EXPECT_EQ(commands_changed.load(), 2);  // the write, then the fail-safe
+    EXPECT_NE(slave.statistics().last_problem.find("comms-loss fail-safe (safe)"), std::string::npos);
+    // A read re-arms it; the master reads back what the fail-safe left.
+    EXPECT_EQ(master.read_actuator_commands(), io::ActuatorCommands{});
+    ASSERT_TRUE(wait_for_failsafe(slave));  // tripped again: the read had re-armed it
+    EXPECT_EQ(slave.statistics().failsafe_trips, 2u);
+}
+
+TEST(ModbusSlaveFailsafe, HoldModeKeepsTheCoilsAndCountsTheTrip) {
+    TcpSlaveOptions options = any_port();
+    options.failsafe = {std::chrono::milliseconds(100), FailsafeMode::hold};
+    ModbusSlave slave(options);
+    ModbusMaster master(master_for(slave), patient());
+    master.write_actuator_commands(sample_commands());
+    ASSERT_TRUE(wait_for_failsafe(slave));
+    EXPECT_EQ(slave.actuator_commands(), sample_commands());
+    EXPECT_EQ(slave.statistics().failsafe_trips, 1u);
+    EXPECT_EQ(slave.statistics().valid_requests, 1u);
+}
+
+TEST(ModbusSlaveFailsafe, OffByDefaultAndANegativeTimeoutIsRefused) {
+    EXPECT_EQ(TcpSlaveOptions{}.failsafe.timeout.count(), 0);
+    TcpSlaveOptions options = any_port();
+    options.failsafe.timeout = std::chrono::milliseconds(-1);
+    EXPECT_THROW(ModbusSlave{options}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rig::modbus

@@ -8,6 +8,9 @@
 
 #include "run_support.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -201,24 +204,39 @@ TEST(WholeRun, WiredControllerInRealTimePassesThePapersLimits) {
     }
 }
 
-// A GNSS line on a pseudo-terminal that no board has opened: the rig must not
-// stream into it for the whole case (it used to end after the case's wall-time
-// bound with "simulated 0.0 s" and an empty trace), but fail at once, naming
-// the port, and keep what it recorded.
+// A GNSS line on a pseudo-terminal that a board opened but never reads: the
+// rig must not stream into it for the whole case (it used to end after the
+// case's wall-time bound with "simulated 0.0 s" and an empty trace), but fail
+// at once, naming the port, and keep what it recorded. (A board that never
+// opens it at all is board_not_attached: tests/external_board_test.cpp.)
 TEST(WholeRun, AGnssLineNobodyReadsFailsAtOnceNamingThePort) {
     const fs::path dir = fresh_dir("unread-gnss");
     std::string text = read_all(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
     text += "mode: realtime\nwiring: { gnss: serial, gnss_port: pty, controller: external }\n";
     std::ofstream(dir / "unread.yaml") << text;
+    const fs::path out = dir / "out";
     const auto started = std::chrono::steady_clock::now();
-    const RunOutcome outcome = rig_run("'" + (dir / "unread.yaml").string() + "'", dir / "out");
+    rig::ChildProcess run({RIG_BINARY_DIR "/bin/rig", "run", (dir / "unread.yaml").string(), "--out", out.string()},
+                          dir / "rig.log");
+    // The board: opens the line named in attach.json, then reads nothing.
+    const fs::path attach = out / "cases" / "short-fusion" / "attach.json";
+    for (int i = 0; i < 3000 && !fs::exists(attach) && !run.exit_description(); ++i) {
+        rig::RealtimeClock().sleep_until_ns(rig::RealtimeClock().now_ns() + rig::seconds_to_ns(0.01));
+    }
+    ASSERT_TRUE(fs::exists(attach)) << read_all(dir / "rig.log");
+    const std::string port = nlohmann::json::parse(read_all(attach))["ports"][0]["path"];
+    const int held = ::open(port.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    ASSERT_GE(held, 0) << port;
+    const std::string ended = run.stop(std::chrono::milliseconds(60000));
+    ::close(held);
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    EXPECT_EQ(outcome.exit_code, 1) << outcome.log;
-    ASSERT_TRUE(outcome.results.contains("cases")) << outcome.log;
-    const nlohmann::json& result = outcome.results["cases"][0];
+    EXPECT_EQ(ended, "process exited with status 1") << read_all(dir / "rig.log");
+    const nlohmann::json results = nlohmann::json::parse(read_all(out / "results.json"));
+    ASSERT_TRUE(results.contains("cases")) << read_all(dir / "rig.log");
+    const nlohmann::json& result = results["cases"][0];
     EXPECT_EQ(result["error_kind"], "wire_unread") << result.dump(2);
     const std::string error = result["error"].is_string() ? result["error"].get<std::string>() : "";
-    EXPECT_NE(error.find("nobody reads the GNSS line /dev/pts/"), std::string::npos) << error;
+    EXPECT_NE(error.find("nobody reads the GNSS line " + port), std::string::npos) << error;
     // The case is longer than this bound (about 12 s of route); the 2 s unread
     // bound plus start-up is far below it, even on a loaded machine.
     EXPECT_LT(wall_s, 11.0);

@@ -17,6 +17,8 @@ constexpr std::pair<FailureKind, std::string_view> kFailureKindNames[] = {
     {FailureKind::feedback_loop, "feedback_loop"},
     {FailureKind::interrupted, "interrupted"},
     {FailureKind::harness_error, "harness_error"},
+    {FailureKind::board_not_attached, "board_not_attached"},
+    {FailureKind::board_silent, "board_silent"},
 };
 }  // namespace
 

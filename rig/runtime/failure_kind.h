@@ -21,6 +21,8 @@ enum class FailureKind {
     feedback_loop,         // nodes kept answering each other at one instant
     interrupted,           // SIGINT / SIGTERM stopped the run
     harness_error,         // the rig itself failed (a trace it cannot write, a bad wire...)
+    board_not_attached,    // an external board did not attach to its wires within board.attach_timeout_s
+    board_silent,          // the board's Modbus master sent no valid request for board.silence_timeout_s
 };
 std::string_view to_string(FailureKind kind);
 // The kind with this name; nullopt for an unknown one.

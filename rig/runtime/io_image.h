@@ -49,6 +49,10 @@ struct ControllerIndicators {
     bool operator==(const ControllerIndicators&) const = default;
 };
 
+// The frequency input's capture timer (main_flow_last_edge_us): 1 MHz, 32 bits,
+// counting from the case clock's t = 0 and wrapping every 2^32 us (71.6 min).
+inline constexpr std::uint32_t kCaptureTimerHz = 1'000'000;
+
 // 12-bit ADC full scale of the STM32F407's converters, and its reference voltage.
 inline constexpr std::uint16_t kAdcFullScale = 4095;
 inline constexpr double kAdcReferenceV = 3.3;

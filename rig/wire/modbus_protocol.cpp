@@ -240,6 +240,8 @@ std::optional<std::size_t> rtu_request_length(std::span<const std::uint8_t> fram
 
 // ---------------------------------------------------------------- wire settings
 
+std::string_view to_string(FailsafeMode mode) { return mode == FailsafeMode::safe ? "safe" : "hold"; }
+
 Parity parse_parity(std::string_view text) {
     std::string lower;
     for (char c : text) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);

@@ -9,6 +9,7 @@
 // Modbus over Serial Line guide V1.02: function codes, quantity limits, the
 // order of checks (function, quantity/structure -> 03, address -> 02), the
 // MBAP header, the RTU CRC and the 3.5-character inter-frame silence.
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -54,6 +55,21 @@ struct TcpEndpoint {
 TcpEndpoint parse_tcp_endpoint(std::string_view text);
 // True for IPv4 literals in 127.0.0.0/8 (the only destinations these machines use).
 bool is_loopback_ipv4(std::string_view address);
+
+// The comms-loss watchdog of the rig's board I/O, as a real Modbus I/O module
+// has one: `timeout` after the last valid request addressed to this slave, the
+// outputs (coils) go to `mode`. A later valid request re-arms it; the coils then
+// stay as the fail-safe left them until the master writes them again (as on a
+// module whose watchdog tripped: the master must restore its outputs).
+enum class FailsafeMode {
+    safe,  // every coil 0, i.e. de-energised: ball-valve motor stopped, unloading valve and sections closed
+    hold,  // coils keep their last written state (the trip is only counted)
+};
+struct CommsFailsafe {
+    std::chrono::milliseconds timeout{0};  // 0 = no watchdog (the `rig modbus serve` default)
+    FailsafeMode mode = FailsafeMode::safe;
+};
+std::string_view to_string(FailsafeMode mode);
 
 // ---------------------------------------------------------------- application protocol (PDU)
 

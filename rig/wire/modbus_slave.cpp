@@ -194,7 +194,9 @@ public:
         if (options.partial_frame_timeout.count() <= 0) {
             throw std::invalid_argument("Modbus TCP partial_frame_timeout must be > 0 ms");
         }
+        check_failsafe_options(options.failsafe);
         tcp_options_ = options;
+        failsafe_ = options.failsafe;
         listen_fd_ = listen_tcp(options.bind_address, options.port, tcp_port_);
         endpoint_ = "tcp " + options.bind_address + ":" + std::to_string(tcp_port_);
         start_thread([this] { run_tcp(); });
@@ -209,10 +211,16 @@ public:
         if (options.frame_end_silence.count() <= 0 || options.write_timeout.count() <= 0) {
             throw std::invalid_argument("Modbus RTU frame_end_silence and write_timeout must be > 0 ms");
         }
+        check_failsafe_options(options.failsafe);
         rtu_options_ = options;
+        failsafe_ = options.failsafe;
         serial_fd_ = open_serial_line(options.line);
         endpoint_ = "rtu " + describe(options.line) + " slave " + std::to_string(options.slave_id);
         start_thread([this] { run_rtu(); });
+    }
+
+    static void check_failsafe_options(const CommsFailsafe& failsafe) {
+        if (failsafe.timeout.count() < 0) throw std::invalid_argument("Modbus fail-safe timeout must be >= 0 ms (0 = off)");
     }
 
     void stop() {
@@ -278,6 +286,17 @@ public:
         return failure_;
     }
 
+    std::optional<std::chrono::nanoseconds> since_last_request() const {
+        std::lock_guard lock(mutex_);
+        if (!last_request_ns_) return std::nullopt;
+        return std::chrono::nanoseconds(clock_.now_ns() - *last_request_ns_);
+    }
+
+    bool failsafe_active() const {
+        std::lock_guard lock(mutex_);
+        return failsafe_tripped_;
+    }
+
     const std::string& endpoint() const { return endpoint_; }
     std::uint16_t tcp_port() const { return tcp_port_; }
 
@@ -332,6 +351,9 @@ private:
         {
             std::lock_guard lock(mutex_);
             served = serve_request(pdu, image_);
+            ++stats_.valid_requests;
+            last_request_ns_ = clock_.now_ns();
+            failsafe_tripped_ = false;
             if (served.exception) {
                 switch (*served.exception) {
                     case ExceptionCode::illegal_function: ++stats_.illegal_function; break;
@@ -371,6 +393,49 @@ private:
 
     bool wake_requested(const pollfd& wake) const { return stop_requested_ || (wake.revents & POLLIN) != 0; }
 
+    // ---------------------------------------------------------------- comms-loss watchdog
+
+    // When the watchdog trips next (kNever: off, not armed before the first
+    // request, or already tripped).
+    TimeNs failsafe_deadline_ns() const {
+        if (failsafe_.timeout.count() <= 0) return kNever;
+        std::lock_guard lock(mutex_);
+        if (!last_request_ns_ || failsafe_tripped_) return kNever;
+        return *last_request_ns_ + failsafe_.timeout.count() * kNsPerMs;
+    }
+
+    void check_failsafe(TimeNs now) {
+        const TimeNs deadline = failsafe_deadline_ns();
+        if (deadline == kNever || now < deadline) return;
+        std::optional<MasterWrite> write;
+        {
+            std::lock_guard lock(mutex_);
+            failsafe_tripped_ = true;
+            ++stats_.failsafe_trips;
+            if (failsafe_.mode == FailsafeMode::safe && image_.coils != Coils{}) {
+                image_.coils = Coils{};
+                MasterWrite report;
+                report.commands = decode_coils(image_.coils);
+                report.indicators = decode_holding_registers(image_.holding_registers);
+                report.commands_changed = true;
+                report.sequence = stats_.master_writes;
+                previous_coils_ = image_.coils;
+                write = report;
+            }
+        }
+        report_problem(endpoint_ + ": no valid request for " + std::to_string(failsafe_.timeout.count()) +
+                       " ms: comms-loss fail-safe (" + std::string(to_string(failsafe_.mode)) + ")" +
+                       (write ? ", every coil de-energised" : ""));
+        // Told like a write, so whoever shows the outputs sees them change at once.
+        if (write && callbacks_.on_master_write) {
+            try {
+                callbacks_.on_master_write(*write);
+            } catch (...) {
+                count([](auto& stats) { ++stats.callback_errors; });
+            }
+        }
+    }
+
     // ---------------------------------------------------------------- TCP
 
     void run_tcp() {
@@ -388,6 +453,7 @@ private:
             }
             const bool accepting = now >= accept_paused_until_ns;
             if (!accepting) deadline = std::min(deadline, accept_paused_until_ns);
+            deadline = std::min(deadline, failsafe_deadline_ns());
             fds.clear();
             fds.push_back({wake_fd_.get(), POLLIN, 0});
             fds.push_back({accepting ? listen_fd_.get() : -1, POLLIN, 0});  // fd -1: ignored by poll
@@ -405,6 +471,7 @@ private:
                 accept_paused_until_ns = after + kRetryPauseNs;
             }
             expire_partial_frames(connections, after);
+            check_failsafe(after);
             std::erase_if(connections, [](const Connection& connection) { return !connection.open; });
         }
     }
@@ -549,11 +616,14 @@ private:
         bool line_failing = false;   // reported as failing, not yet working again
         while (!stop_requested_) {
             const TimeNs now = clock_.now_ns();
+            check_failsafe(now);  // also while the line is down
             pollfd fds[2] = {{wake_fd_.get(), POLLIN, 0}, {serial_fd_.get(), POLLIN, 0}};
             // A hung-up line reports POLLHUP at once, forever: look at it again only after a pause.
             const nfds_t watched = line_down ? 1 : 2;
-            const int timeout_ms =
-                line_down ? static_cast<int>(kRetryPauseNs / kNsPerMs) : poll_timeout_ms(assembler.next_deadline_ns(), now);
+            const TimeNs deadline = std::min(assembler.next_deadline_ns(), failsafe_deadline_ns());
+            const int timeout_ms = line_down ? static_cast<int>(std::min<TimeNs>(kRetryPauseNs, std::max<TimeNs>(
+                                                                    failsafe_deadline_ns() - now, 0)) / kNsPerMs)
+                                             : poll_timeout_ms(deadline, now);
             const int ready = ::poll(fds, watched, timeout_ms);
             if (ready < 0) {
                 if (errno == EINTR) continue;
@@ -587,6 +657,7 @@ private:
             }
             for (auto& event : events) handle_rtu_event(event, last_byte_ns);
             events.clear();
+            check_failsafe(clock_.now_ns());
         }
     }
 
@@ -670,6 +741,9 @@ private:
     HoldingRegisters previous_holding_{};
     ModbusSlaveStatistics stats_;
     std::optional<std::string> failure_;
+    std::optional<TimeNs> last_request_ns_;  // clock_ time of the last valid request
+    bool failsafe_tripped_ = false;
+    CommsFailsafe failsafe_;
 
     ModbusSlaveCallbacks callbacks_;
     std::string endpoint_;
@@ -709,6 +783,8 @@ std::uint64_t ModbusSlave::wait_for_master_write(std::uint64_t seen, std::chrono
     return impl_->wait_for_master_write(seen, timeout);
 }
 ModbusSlaveStatistics ModbusSlave::statistics() const { return impl_->statistics(); }
+std::optional<std::chrono::nanoseconds> ModbusSlave::since_last_request() const { return impl_->since_last_request(); }
+bool ModbusSlave::failsafe_active() const { return impl_->failsafe_active(); }
 std::optional<std::string> ModbusSlave::server_failure() const { return impl_->server_failure(); }
 void ModbusSlave::stop() { impl_->stop(); }
 

@@ -33,6 +33,7 @@
 
 namespace rig::modbus {
 
+
 struct TcpSlaveOptions {
     // Loopback only unless allow_non_loopback: these machines never talk to
     // anything but 127.0.0.1 (docs/design.md). A bench with a board on Ethernet
@@ -48,6 +49,7 @@ struct TcpSlaveOptions {
     // connection is closed (the stream cannot be trusted any more).
     std::chrono::milliseconds partial_frame_timeout{3000};
     // Any TCP unit id is served (the slave is the end device, not a gateway).
+    CommsFailsafe failsafe;
 };
 
 struct RtuSlaveOptions {
@@ -60,6 +62,7 @@ struct RtuSlaveOptions {
     std::chrono::milliseconds frame_end_silence{50};
     // A response the line does not take within this is dropped (and counted).
     std::chrono::milliseconds write_timeout{1000};
+    CommsFailsafe failsafe;
 };
 
 // What the master wrote: reported after every write request carried out
@@ -83,6 +86,9 @@ struct ModbusSlaveCallbacks {
 };
 
 struct ModbusSlaveStatistics {
+    // Valid requests addressed to this slave (or broadcast), answered or
+    // refused with an exception: what shows the master is alive.
+    std::uint64_t valid_requests = 0;
     // Requests served.
     std::uint64_t requests_answered = 0;       // normal response made (responses_not_sent: lost on the way)
     std::uint64_t broadcast_requests = 0;      // RTU address 0: carried out, never answered
@@ -102,6 +108,7 @@ struct ModbusSlaveStatistics {
     std::uint64_t connections_timed_out = 0;         // a started frame not completed in time
     std::uint64_t connections_evicted = 0;           // least recently active, to admit a new one
     std::uint64_t callback_errors = 0;               // exceptions thrown by a callback
+    std::uint64_t failsafe_trips = 0;                // comms-loss watchdog expiries (CommsFailsafe)
     std::string last_problem;                        // the latest on_problem line
 };
 
@@ -137,6 +144,11 @@ public:
     std::uint64_t wait_for_master_write(std::uint64_t seen, std::chrono::milliseconds timeout) const;
 
     ModbusSlaveStatistics statistics() const;
+    // How long since the last valid request addressed to this slave (statistics()
+    // valid_requests), on the slave's monotonic clock; nullopt before the first.
+    std::optional<std::chrono::nanoseconds> since_last_request() const;
+    // Whether the comms-loss watchdog has tripped and no valid request came since.
+    bool failsafe_active() const;
     // Set when the server thread ended on an unexpected error (it then serves
     // no more); the message says what. Never set in normal operation.
     std::optional<std::string> server_failure() const;

@@ -1,0 +1,362 @@
+// A stand-in for a team's controller board on the bench, written from the
+// documentation alone (docs/modbus-register-map.md: "External boards", the
+// register map and "Scalings"): it takes the ports from the attach.json the rig
+// writes, reads the NMEA line, polls the rig's Modbus RTU slave with its own
+// libmodbus master (addresses and scalings as the page gives them, none of the
+// rig's register-map code) and drives the spray circuit as a simple controller
+// of the static flow test:
+//
+//   reset      ball valve driven closed for longer than its full travel;
+//   pre-adjust driven open for the time the valve calibration's opening for the
+//              target (at the pump flow read through Eq. 8) takes to reach;
+//   idle       sections closed, unloading valve open (the pump's flow to the tank);
+//   spraying   spray switch on: unloading closed, sections open, the opening
+//              trimmed from the KF11 flow (Eq. 3 over the capture timer).
+//
+//   board_player --attach OUT/cases/NAME/attach.json [--target-l-min 20]
+//                [--sections 3] [--stop-polling-after-s S] [--wait-s 120]
+//
+// --stop-polling-after-s: after S seconds of polling, the board goes quiet on
+// Modbus (a hung firmware task) while it keeps reading NMEA and stays alive.
+// Exit 0 when the rig closed the wires (the case ended), 1 on an error.
+#include <fcntl.h>
+#include <modbus/modbus.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "rig/nmea/nmea_parser.h"
+#include "rig/runtime/clock.h"
+
+namespace {
+
+// ---- From docs/modbus-register-map.md.
+constexpr int kSlaveId = 1;
+constexpr int kInputRegisterCount = 9;  // registers 0-8 in one FC 04: the counters never tear
+constexpr int kCoilCount = 16;          // one FC 15 of coils 0-15 sets everything
+constexpr int kCoilBallValveForward = 0;
+constexpr int kCoilBallValveReverse = 1;
+constexpr int kCoilUnloadingValveOpen = 2;
+constexpr int kCoilFirstSection = 8;
+// Valve calibration lines (opening %, slope, intercept L/min): main = slope x pump + intercept.
+struct CalibrationLine {
+    double opening_pct, slope, intercept_l_min;
+};
+constexpr CalibrationLine kCalibration[] = {
+    {87.0, 0.35, 3.315}, {90.0, 0.38, 4.182}, {93.0, 0.42, 5.938}, {94.0, 0.46, 7.694}, {95.0, 0.50, 9.95}};
+
+// ---- This board's own choices.
+constexpr double kPollPeriodS = 0.02;
+constexpr double kResetMarginS = 1.5;  // driven closed this much beyond the full travel: at the end stop whatever the start
+// After the sections open or the valve moves, the pipeline settles (its time
+// constant is a few tenths of a second) before the flow is measured again,
+// over a window long enough for tens of KF11 pulses.
+constexpr double kSettleS = 1.0;
+constexpr double kFlowWindowS = 1.0;
+// Of target: the judged band is +-3 %; a trim below 2 % would be a move of
+// under 0.2 % opening, of the order of what one poll cycle of motor time does.
+constexpr double kTrimDeadbandPct = 2.0;
+constexpr double kTrimGain = 0.7;         // of the calibration's correction: never overshoot
+constexpr double kMaxTrimDriveS = 0.3;
+
+struct Options {
+    std::filesystem::path attach_file;
+    double target_l_min = 20.0;
+    int sections = 3;
+    std::optional<double> stop_polling_after_s;
+    double wait_s = 120.0;
+};
+
+struct Scalings {
+    double adc_full_scale = 4095;
+    double pump_full_scale_m3_h = 8.0;
+    double pulses_per_l = 90.0;
+    double capture_timer_hz = 1e6;
+    // The ball valve: full travel, the motor's start delay, the gear play taken up on a reversal.
+    double valve_travel_s = 11.0;
+    double valve_start_delay_s = 0.02;
+    double valve_backlash_pct = 0.3;
+};
+
+double predicted_flow(double opening_pct, double pump_l_min) {
+    // Between calibrated openings linearly; the end segments extended.
+    std::size_t upper = 1;
+    while (upper + 1 < std::size(kCalibration) && opening_pct > kCalibration[upper].opening_pct) ++upper;
+    const CalibrationLine& a = kCalibration[upper - 1];
+    const CalibrationLine& b = kCalibration[upper];
+    const double flow_a = a.slope * pump_l_min + a.intercept_l_min;
+    const double flow_b = b.slope * pump_l_min + b.intercept_l_min;
+    return flow_a + (flow_b - flow_a) * (opening_pct - a.opening_pct) / (b.opening_pct - a.opening_pct);
+}
+
+double opening_for(double flow_l_min, double pump_l_min) {
+    double low = 0.0, high = 100.0;  // flow rises with opening: bisect
+    for (int i = 0; i < 60; ++i) {
+        const double mid = (low + high) / 2;
+        (predicted_flow(mid, pump_l_min) < flow_l_min ? low : high) = mid;
+    }
+    return (low + high) / 2;
+}
+
+class Board {
+public:
+    Board(const Options& options, const nlohmann::json& attach) : options_(options) {
+        for (const nlohmann::json& port : attach.at("ports")) {
+            const std::string role = port.at("role");
+            if (role == "gnss_nmea") nmea_path_ = port.at("path");
+            if (role == "modbus_rtu") modbus_path_ = port.at("path");
+        }
+        if (nmea_path_.empty() || modbus_path_.empty()) throw std::runtime_error("attach.json lacks gnss_nmea or modbus_rtu");
+        const nlohmann::json& scalings = attach.at("scalings");
+        scalings_.adc_full_scale = scalings.at("adc_full_scale_counts");
+        scalings_.pump_full_scale_m3_h = scalings.at("pump_flow_full_scale_m3_h");
+        scalings_.pulses_per_l = scalings.at("main_flow_pulses_per_l");
+        scalings_.capture_timer_hz = scalings.at("capture_timer_hz");
+        scalings_.valve_travel_s = scalings.at("valve_travel_s");
+        scalings_.valve_start_delay_s = scalings.at("valve_motor_start_delay_s");
+        scalings_.valve_backlash_pct = scalings.at("valve_backlash_pct");
+
+        nmea_fd_ = ::open(nmea_path_.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+        if (nmea_fd_ < 0) throw std::runtime_error("cannot open " + nmea_path_ + ": " + std::strerror(errno));
+        modbus_ = modbus_new_rtu(modbus_path_.c_str(), 115200, 'N', 8, 1);
+        if (modbus_ == nullptr || modbus_set_slave(modbus_, kSlaveId) != 0 || modbus_connect(modbus_) != 0) {
+            throw std::runtime_error("cannot open Modbus RTU on " + modbus_path_ + ": " + modbus_strerror(errno));
+        }
+        modbus_set_response_timeout(modbus_, 0, 500'000);
+    }
+    ~Board() {
+        if (modbus_ != nullptr) {
+            modbus_close(modbus_);
+            modbus_free(modbus_);
+        }
+        if (nmea_fd_ >= 0) ::close(nmea_fd_);
+    }
+
+    // Returns when the rig has closed the wires (the case is over).
+    void run() {
+        const double started_s = now_s();
+        while (!line_closed_) {
+            read_nmea();
+            const double t = now_s() - started_s;
+            const bool polling = !options_.stop_polling_after_s || t < *options_.stop_polling_after_s;
+            if (polling) {
+                poll_and_drive(t);
+                end_drive_on_time(started_s);
+            }
+            clock_.sleep_until_ns(clock_.now_ns() + rig::seconds_to_ns(kPollPeriodS));
+        }
+        std::cout << "board: " << sentences_ << " NMEA sentences parsed (" << fixes_ << " GGA), " << polls_
+                  << " polls, " << failed_polls_ << " failed; " << (line_closed_ ? "the rig closed the line" : "stopped")
+                  << std::endl;
+    }
+
+private:
+    double now_s() const { return rig::ns_to_seconds(clock_.now_ns()); }
+
+    void read_nmea() {
+        char chunk[1024];
+        for (;;) {
+            const ssize_t got = ::read(nmea_fd_, chunk, sizeof chunk);
+            if (got > 0) {
+                pending_.append(chunk, static_cast<std::size_t>(got));
+                continue;
+            }
+            if (got < 0 && (errno == EAGAIN || errno == EINTR)) break;
+            line_closed_ = true;  // EOF / EIO: the rig ended the case and closed its end
+            break;
+        }
+        for (std::size_t end; (end = pending_.find('\n')) != std::string::npos; pending_.erase(0, end + 1)) {
+            const rig::nmea::ParseResult parsed = rig::nmea::parse_sentence(std::string_view(pending_).substr(0, end));
+            if (!parsed.ok()) continue;
+            ++sentences_;
+            if (parsed.sentence->type == "GGA") ++fixes_;
+        }
+    }
+
+    void failed(const char* what) {
+        if (++failed_polls_ <= 5) std::cout << "board: " << what << ": " << modbus_strerror(errno) << std::endl;
+        // A late response still on its way must not be taken for the next request's.
+        modbus_flush(modbus_);
+    }
+
+    // A drive ending before the next poll is ended by a timer, as firmware
+    // would: the relay's on-time is then not rounded to poll cycles.
+    void end_drive_on_time(double started_s) {
+        const double until_end = drive_until_s_ - (now_s() - started_s);
+        if (until_end <= 0 || until_end > kPollPeriodS + cycle_s_) return;
+        clock_.sleep_until_ns(clock_.now_ns() + rig::seconds_to_ns(until_end));
+        coils_[kCoilBallValveForward] = 0;
+        coils_[kCoilBallValveReverse] = 0;
+        if (modbus_write_bits(modbus_, 0, kCoilCount, coils_) != kCoilCount) failed("FC 15");
+    }
+
+    // One poll: inputs in, outputs out.
+    void poll_and_drive(double t) {
+        std::uint16_t registers[kInputRegisterCount];
+        std::uint8_t inputs[2];
+        if (modbus_read_input_registers(modbus_, 0, kInputRegisterCount, registers) != kInputRegisterCount) {
+            failed("FC 04");
+            return;
+        }
+        if (modbus_read_input_bits(modbus_, 0, 2, inputs) != 2) {
+            failed("FC 02");
+            return;
+        }
+        ++polls_;
+        if (last_poll_s_) cycle_s_ = t - *last_poll_s_;
+        last_poll_s_ = t;
+        const std::uint32_t flow_pulses = (std::uint32_t{registers[2]} << 16) | registers[3];
+        const std::uint32_t edge_ticks = (std::uint32_t{registers[7]} << 16) | registers[8];
+        const double pump_l_min =
+            registers[4] / scalings_.adc_full_scale * scalings_.pump_full_scale_m3_h * 1000.0 / 60.0;  // Eq. 8
+        const bool spray_switch = inputs[1] != 0;
+        decide(t, spray_switch, pump_l_min, flow_pulses, edge_ticks);
+        std::fill(std::begin(coils_), std::end(coils_), 0);
+        const bool driving = t < drive_until_s_;
+        coils_[kCoilBallValveForward] = driving && drive_forward_;
+        coils_[kCoilBallValveReverse] = driving && !drive_forward_;
+        coils_[kCoilUnloadingValveOpen] = !spray_switch;
+        for (int section = 0; section < options_.sections; ++section) coils_[kCoilFirstSection + section] = spray_switch;
+        if (modbus_write_bits(modbus_, 0, kCoilCount, coils_) != kCoilCount) failed("FC 15");
+    }
+
+    // Moves the valve by `pct` of its travel (sign = direction): the motor's
+    // start delay and, on a reversal, the gear play come on top.
+    double drive_by(double t, double pct) {
+        const bool forward = pct > 0;
+        double seconds = std::abs(pct) / 100.0 * scalings_.valve_travel_s + scalings_.valve_start_delay_s;
+        if (forward != drive_forward_) seconds += scalings_.valve_backlash_pct / 100.0 * scalings_.valve_travel_s;
+        drive_forward_ = forward;
+        drive_until_s_ = t + seconds;
+        return seconds;
+    }
+
+    void decide(double t, bool spray_switch, double pump_l_min, std::uint32_t pulses, std::uint32_t edge_ticks) {
+        if (reset_started_ && !pre_adjusted_ && t > drive_until_s_ - scalings_.valve_travel_s / 2) {
+            pump_sum_l_min_ += pump_l_min;
+            ++pump_samples_;
+        }
+        if (!reset_started_) {
+            reset_started_ = true;
+            drive_forward_ = false;
+            drive_until_s_ = t + scalings_.valve_travel_s + kResetMarginS;
+            return;
+        }
+        if (t < drive_until_s_) return;
+        if (!pre_adjusted_) {
+            pre_adjusted_ = true;
+            pump_l_min = pump_sum_l_min_ / pump_samples_;  // the plunger pump pulsates: its mean
+            const double opening = opening_for(options_.target_l_min, pump_l_min);
+            std::cout << "board: pump " << pump_l_min << " L/min, pre-adjusting to " << opening << " %" << std::endl;
+            opening_pct_ = opening;
+            drive_by(t, opening);
+            return;
+        }
+        if (!spray_switch) {
+            window_start_.reset();
+            settled_at_s_.reset();
+            return;
+        }
+        if (!settled_at_s_) settled_at_s_ = t + kSettleS;  // the sections just opened
+        if (t < *settled_at_s_) return;
+        // Eq. 3 from edge to edge: pulses between two captured edges over the capture-time between them.
+        if (!window_start_) {
+            window_start_ = Sample{t, pulses, edge_ticks};
+            return;
+        }
+        if (t - window_start_->t < kFlowWindowS || pulses == window_start_->pulses) return;
+        const double edge_s = static_cast<std::uint32_t>(edge_ticks - window_start_->edge_ticks) / scalings_.capture_timer_hz;
+        const double flow = static_cast<std::uint32_t>(pulses - window_start_->pulses) / scalings_.pulses_per_l / edge_s * 60.0;
+        window_start_ = Sample{t, pulses, edge_ticks};
+        const double error = options_.target_l_min - flow;
+        std::cout << "board: t=" << t << " s flow " << flow << " L/min" << std::endl;
+        if (std::abs(error) < options_.target_l_min * kTrimDeadbandPct / 100.0) return;
+        // The opening change the calibration says the error needs, as motor time.
+        const double per_pct = predicted_flow(opening_pct_ + 0.5, pump_l_min) - predicted_flow(opening_pct_ - 0.5, pump_l_min);
+        const double largest_pct = kMaxTrimDriveS / scalings_.valve_travel_s * 100.0;
+        const double delta_pct = std::clamp(kTrimGain * error / per_pct, -largest_pct, largest_pct);
+        opening_pct_ += delta_pct;
+        const double drive_s = drive_by(t, delta_pct);
+        window_start_.reset();
+        settled_at_s_ = t + drive_s + kSettleS;
+    }
+
+    struct Sample {
+        double t;
+        std::uint32_t pulses;
+        std::uint32_t edge_ticks;
+    };
+    Options options_;
+    Scalings scalings_;
+    std::string nmea_path_, modbus_path_;
+    int nmea_fd_ = -1;
+    modbus_t* modbus_ = nullptr;
+    rig::RealtimeClock clock_;
+    std::string pending_;
+    bool line_closed_ = false;
+    long sentences_ = 0, fixes_ = 0, polls_ = 0, failed_polls_ = 0;
+    bool reset_started_ = false, pre_adjusted_ = false, drive_forward_ = false;
+    double drive_until_s_ = 0.0, opening_pct_ = 0.0;
+    std::optional<Sample> window_start_;
+    std::optional<double> settled_at_s_;
+    std::optional<double> last_poll_s_;
+    double cycle_s_ = kPollPeriodS;  // the last poll-to-poll time
+    std::uint8_t coils_[kCoilCount] = {};
+    double pump_sum_l_min_ = 0.0;
+    long pump_samples_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Options options;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (i + 1 >= argc) {
+            std::cerr << "board_player: " << arg << " needs a value\n";
+            return 1;
+        }
+        const std::string value = argv[++i];
+        if (arg == "--attach") options.attach_file = value;
+        else if (arg == "--target-l-min") options.target_l_min = std::stod(value);
+        else if (arg == "--sections") options.sections = std::stoi(value);
+        else if (arg == "--stop-polling-after-s") options.stop_polling_after_s = std::stod(value);
+        else if (arg == "--wait-s") options.wait_s = std::stod(value);
+        else {
+            std::cerr << "board_player: unknown option " << arg << "\n";
+            return 1;
+        }
+    }
+    try {
+        // The rig writes attach.json before it waits for the board.
+        const rig::RealtimeClock clock;
+        while (!std::filesystem::exists(options.attach_file)) {
+            if (rig::ns_to_seconds(clock.now_ns()) > options.wait_s) {
+                std::cerr << "board_player: no " << options.attach_file << " after " << options.wait_s << " s\n";
+                return 1;
+            }
+            clock.sleep_until_ns(clock.now_ns() + rig::seconds_to_ns(0.05));
+        }
+        std::ifstream in(options.attach_file);
+        const nlohmann::json attach = nlohmann::json::parse(in);
+        Board board(options, attach);
+        board.run();
+        return 0;
+    } catch (const std::exception& error) {
+        std::cerr << "board_player: " << error.what() << "\n";
+        return 1;
+    }
+}
