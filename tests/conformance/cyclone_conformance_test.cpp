@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -59,12 +60,25 @@ RunOutcome rig_run(const fs::path& case_file, const fs::path& out) {
     return run;
 }
 
+// The RTPS vendor id (first 4 hex digits of the GUID prefix) of the
+// participant named `controller`, from the trace's discovery record.
+std::string controller_vendor(const fs::path& out) {
+    const fs::path trace = out / "cases" / "rtk-breakpoint-controller" / "trace.sqlite";
+    return rig::testing::read_all_command(
+        "sqlite3 '" + trace.string() +
+        "' \"select distinct substr(guid_prefix, 1, 4) from discovery where participant = 'controller'\"");
+}
+
 TEST(CycloneConformance, ACycloneFollowerIsJudgedAndLeavesTheFastDdsExamplesTraceDigest) {
     const fs::path dir = rig::testing::fresh_dir("cyclone-conformance");
     fs::create_directories(dir / "cyclone");
     fs::create_directories(dir / "fastdds");
+    // The follower under strace: what the kernel sees it send (loopback only,
+    // docs/design.md "DDS and the network"; Cyclone's own defaults would multicast).
+    const fs::path strace_log = dir / "cyclone" / "strace.log";
     const fs::path cyclone_case = case_with_command(
-        dir / "cyclone", "[ '" RIG_CYCLONE_FOLLOWER "', --cyclone-config, '" RIG_CYCLONE_LOOPBACK_CONFIG "' ]");
+        dir / "cyclone", "[ strace, -f, -qq, -e, 'trace=sendto,sendmsg,sendmmsg,connect', -o, '" + strace_log.string() +
+                             "', '" RIG_CYCLONE_FOLLOWER "', --cyclone-config, '" RIG_CYCLONE_LOOPBACK_CONFIG "' ]");
     const fs::path fastdds_case = case_with_command(dir / "fastdds", "[ '" RIG_CONFORMANCE_EXAMPLE_CONTROLLER "' ]");
 
     const RunOutcome cyclone = rig_run(cyclone_case, dir / "cyclone" / "out");
@@ -76,8 +90,18 @@ TEST(CycloneConformance, ACycloneFollowerIsJudgedAndLeavesTheFastDdsExamplesTrac
     EXPECT_LT(cyclone.result["metrics"]["breakpoint_error_m"].get<double>(), 0.55) << cyclone.result.dump(2);
     EXPECT_LT(cyclone.result["metrics"]["breakpoint_store_error_m"].get<double>(), 0.10) << cyclone.result.dump(2);
 
+    const std::set<std::string> destinations = rig::testing::strace_destinations(strace_log);
+    EXPECT_TRUE(destinations.count("127.0.0.1")) << "strace saw no send at all: " << read_all(strace_log).substr(0, 2000);
+    for (const std::string& destination : destinations) {
+        EXPECT_EQ(destination, "127.0.0.1") << "the Cyclone follower sent to " << destination << " (" << strace_log << ")";
+    }
+    // The controller's participant was Cyclone's: its GUID prefix starts with
+    // the RTPS vendor id 01.10 (Eclipse Cyclone DDS), the Fast DDS run's with 01.0f.
+    EXPECT_EQ(controller_vendor(dir / "cyclone" / "out"), "0110\n");
+
     const RunOutcome fastdds = rig_run(fastdds_case, dir / "fastdds" / "out");
     ASSERT_TRUE(fastdds.result.is_object()) << fastdds.log;
+    EXPECT_EQ(controller_vendor(dir / "fastdds" / "out"), "010f\n");
     EXPECT_TRUE(fastdds.result["passed"].get<bool>()) << fastdds.result.dump(2) << fastdds.log;
 
     // Same case, same seed: the same trace, bit for bit.
