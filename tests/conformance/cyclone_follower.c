@@ -294,6 +294,10 @@ typedef struct {
     dds_entity_t tick_reader, ack_writer;
     dds_entity_t nmea_reader, button_reader;
     dds_entity_t tick_waitset, input_waitset;
+    /* A guard condition never triggered (an empty waitset returns at once): a
+       bounded pause between polls of the matched counts, which a tick already
+       waiting in the tick reader must not turn into a busy loop. */
+    dds_entity_t pause_waitset;
     uint64_t nmea_received, button_received;
     nmea_queue_t nmea;
     level_queue_t button;
@@ -411,7 +415,7 @@ static bool wait_matched(link_t* link) {
                     unmatched);
             return false;
         }
-        dds_waitset_wait(link->tick_waitset, NULL, 0, MATCH_POLL_SLICE);
+        dds_waitset_wait(link->pause_waitset, NULL, 0, MATCH_POLL_SLICE);
     }
 }
 
@@ -437,7 +441,7 @@ static bool wait_writer_reaches_readers(link_t* link, dds_entity_t writer, const
                      kStartupTimeoutS, kEventTopic, (int)matched, (unsigned long long)wanted);
             return false;
         }
-        dds_waitset_wait(link->tick_waitset, NULL, 0, MATCH_POLL_SLICE);
+        dds_waitset_wait(link->pause_waitset, NULL, 0, MATCH_POLL_SLICE);
     }
 }
 
@@ -638,6 +642,9 @@ int main(int argc, char** argv) {
 
     link.tick_waitset = checked(dds_create_waitset(link.participant), "a waitset", node_name);
     link.input_waitset = checked(dds_create_waitset(link.participant), "a waitset", node_name);
+    link.pause_waitset = checked(dds_create_waitset(link.participant), "a waitset", node_name);
+    dds_waitset_attach(link.pause_waitset,
+                       checked(dds_create_guardcondition(link.participant), "a guard condition", node_name), 0);
     dds_waitset_attach(link.tick_waitset,
                        checked(dds_create_readcondition(link.tick_reader, DDS_ANY_STATE), "a read condition", node_name), 0);
     dds_waitset_attach(link.input_waitset,
