@@ -7,6 +7,7 @@
 #   share/rig/docs/*.md                                      the controller contract
 #   lib/cmake/rig/rigConfig.cmake (+ version, targets)       find_package(rig)
 #   bin/rig, bin/rig-controller                              the harness and the reference controller (full build)
+#   lib/rig/rig-controller-plugin.so                         the reference controller as a plugin (rig run --in-process)
 include(CMakePackageConfigHelpers)
 
 install(TARGETS rig_runtime rig_idl rig_nmea EXPORT rigTargets
@@ -14,6 +15,7 @@ install(TARGETS rig_runtime rig_idl rig_nmea EXPORT rigTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/runtime/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/runtime
         FILES_MATCHING PATTERN "*.h")
+install(FILES ${PROJECT_BINARY_DIR}/include/rig/runtime/version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/nmea/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/nmea
         FILES_MATCHING PATTERN "*.h")
 install(FILES ${RIG_IDL_GENERATED_HEADERS} ${PROJECT_SOURCE_DIR}/idl/msg_traits.h ${PROJECT_SOURCE_DIR}/idl/topics.h
@@ -35,4 +37,6 @@ install(FILES ${PROJECT_BINARY_DIR}/rigConfig.cmake ${PROJECT_BINARY_DIR}/rigCon
 
 if(TARGET rig AND TARGET rig-controller)
   install(TARGETS rig rig-controller RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # The reference controller as a plugin, where `rig` looks for it (lib/rig/ beside bin/).
+  install(TARGETS rig-controller-plugin LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/rig)
 endif()

@@ -144,7 +144,9 @@ bool ControllerFaults::any() const {
 
 ControllerConfig parse_controller_config(const YamlSection& section) {
     ControllerConfig config;
-    section.allow("command");
+    // The rig's own keys of the section (harness/case_spec.h kControllerRigKeys):
+    // how to run the controller, not how it behaves.
+    for (const char* rig_key : {"command", "plugin", "in_process"}) section.allow(rig_key);
     static constexpr std::array<EnumChoice<Positioning>, 2> kPositioning{
         {{"fusion", Positioning::fusion}, {"rtk_only", Positioning::rtk_only}}};
     config.positioning = section.optional_enum<Positioning>("positioning", kPositioning, config.positioning);

@@ -8,8 +8,9 @@
 namespace rig::controller {
 
 ReferenceController::ReferenceController(std::string node_name, ControllerConfig config,
-                                         const std::filesystem::path& state_dir)
-    : name_(std::move(node_name)),
+                                         const std::filesystem::path& state_dir, std::ostream* log)
+    : log_(log != nullptr ? log : &std::cerr),
+      name_(std::move(node_name)),
       config_(config),
       firmware_(std::move(config), state_dir),
       status_period_ns_(seconds_to_ns(1.0 / config_.status_rate_hz)) {}
@@ -62,7 +63,7 @@ bool ReferenceController::has_unread_input() const {
 TimeNs ReferenceController::step(TimeNs now_ns) {
     // TEST-ONLY fault: a firmware that dies mid-case.
     if (config_.faults.crash_at_s >= 0.0 && now_ns >= seconds_to_ns(config_.faults.crash_at_s)) {
-        std::cerr << name_ << ": crashing at t=" << ns_to_seconds(now_ns) << " s as the fault crash_at_s asks" << std::endl;
+        *log_ << name_ << ": crashing at t=" << ns_to_seconds(now_ns) << " s as the fault crash_at_s asks" << std::endl;
         std::abort();
     }
     // Fixed order (encoder, meters, sensors, GNSS, panel) keeps runs identical
@@ -80,7 +81,7 @@ TimeNs ReferenceController::step(TimeNs now_ns) {
     TimeNs next_wake = firmware_.update(now_ns);
     actuators_writer_->publish_changes(firmware_.actuators());
     for (const msg::BreakpointEvent& event : firmware_.take_events()) event_writer_->publish(event);
-    for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
+    for (const std::string& notice : firmware_.take_notices()) *log_ << name_ << ": " << notice << "\n";
     if (diagnostics_writer_ && firmware_.phase() != last_phase_) {
         last_phase_ = firmware_.phase();
         msg::NmeaSentence line;

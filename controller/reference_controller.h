@@ -13,6 +13,7 @@
 //                actuator/unloading_valve/open, controller/status,
 //                controller/breakpoint_event
 #include <filesystem>
+#include <iosfwd>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,7 +29,9 @@ namespace rig::controller {
 
 class ReferenceController final : public Node {
 public:
-    ReferenceController(std::string node_name, ControllerConfig config, const std::filesystem::path& state_dir);
+    // `log`: where its notices go (stderr when null; a plugin's log file in process).
+    ReferenceController(std::string node_name, ControllerConfig config, const std::filesystem::path& state_dir,
+                        std::ostream* log = nullptr);
     ~ReferenceController() override;
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
@@ -53,6 +56,7 @@ private:
     std::unique_ptr<Writer<msg::VehicleTruth>> forged_vehicle_writer_;
     std::unique_ptr<Writer<msg::HydraulicsTruth>> forged_hydraulics_writer_;
 
+    std::ostream* log_;
     std::string name_;
     ControllerConfig config_;
     SprayController firmware_;

@@ -9,7 +9,7 @@
 #include <set>
 #include <thread>
 
-#include "controller/controller_config.h"
+#include "controller/boundary/boundary_node_config.h"
 #include "emulators/boom_height_sensor.h"
 #include "emulators/flow_meter_kf11.h"
 #include "emulators/panel_switch.h"
@@ -18,6 +18,7 @@
 #include "emulators/spray_circuit.h"
 #include "emulators/spray_circuit_node.h"
 #include "emulators/wheel_encoder.h"
+#include "harness/boundary_runner.h"
 #include "harness/case_session.h"
 #include "harness/case_world.h"
 #include "harness/run_interrupt.h"
@@ -78,6 +79,8 @@ struct LocalNodes {
 
 // What the run learnt about itself, for the trace's meta `run` (results.json echoes it).
 struct RunFacts {
+    std::string controller_mode;     // process, in_process, external
+    std::string in_process_refused;  // asked for in process, ran as a process: why
     double startup_wall_seconds = 0.0;
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
@@ -180,6 +183,9 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     LockstepMaster master(dds, timeouts_of(spec));
     for (Node* node : nodes.all) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });
+    if (InProcessController* controller = session.in_process_controller()) {
+        master.add_in_process_node(controller->node(), controller->dds());
+    }
     master.set_after_round([&](TimeNs t, int round) {
         now_ns = t;
         trace.drain(t, round);
@@ -254,6 +260,8 @@ nlohmann::json run_facts_json(const RunFacts& facts, double wall_seconds) {
                           {"step_max_ms", device.step_max_ms}});
     }
     return {{"wall_seconds", wall_seconds},
+            {"controller_mode", facts.controller_mode},
+            {"in_process_refused", facts.in_process_refused},
             {"startup_wall_seconds", facts.startup_wall_seconds},
             {"realtime_scheduling", facts.realtime_scheduling},
             {"emission_jitter", std::move(jitter)}};
@@ -284,12 +292,23 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
 
 }  // namespace
 
-void validate_for_run(const CaseSpec& spec, const RunOptions& /*options*/) {
-    // The reference controller's own keys are checked before anything starts; a
-    // case naming another controller leaves its section to that controller.
-    if (spec.controller.command.empty()) {
-        controller::parse_controller_config(YamlSection(spec.controller.params));
+void validate_for_run(const CaseSpec& spec, const RunOptions& options) {
+    // Seed 001's reference boundary controller (a program; its configuration
+    // library is the harness's too).
+    if (spec.system == CaseSystem::boundary && spec.controller.command.empty()) {
+        controller::boundary::parse_boundary_node_config(YamlSection(spec.controller.params));
+        return;
     }
+    // The controller's own keys are checked before anything starts, by its
+    // plugin (the harness does not link the reference controller): the
+    // reference controller's, or the plugin a case names. A program without a
+    // plugin checks its section itself when it starts.
+    const std::filesystem::path plugin = controller_plugin_of(spec, options);
+    if (plugin.empty() || spec.wiring.external_controller) return;
+    const auto library = load_controller_plugin(plugin);
+    const std::string error =
+        library->check_config(NodePluginCaseText{spec.source_path.string(), spec.source_text, "controller"});
+    if (!error.empty()) throw std::runtime_error(error);
 }
 
 std::vector<CaseInstance> expand_runs(const std::vector<CaseSpec>& specs, const RunOptions& options) {
@@ -313,6 +332,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 }
 
 CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options) {
+    if (spec.system == CaseSystem::boundary) return run_boundary_case(spec, seed, run_name, options);
     const WallStopwatch wall;
     const std::filesystem::path case_dir = options.out_dir / "cases" / run_name;
     const std::filesystem::path trace_file = case_dir / "trace.sqlite";
@@ -326,6 +346,9 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         // The harness's participant first, watching discovery; then the
         // controller, so every endpoint it makes is seen.
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
+        const ControllerPlacement placement = place_controller(spec, options);
+        std::string in_process_refused = placement.refused;
+        if (placement.plugin) in_process_refused = session.start_in_process_controller(spec, *placement.plugin, case_dir, dds);
         session.start_controller(spec, options.controller_executable, case_dir);
         TraceRecorder trace(dds, trace_file);
         trace.file().set_meta("case", run_name);
@@ -345,6 +368,8 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 
         TimeNs now_ns = 0;
         RunFacts facts;
+        facts.controller_mode = session.controller_mode();
+        facts.in_process_refused = in_process_refused;
         Watchdog watchdog(spec, wall, dds, trace, session, now_ns);
         TraceOutcome outcome;
         try {

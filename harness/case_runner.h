@@ -28,6 +28,12 @@ struct RunOptions {
     std::optional<std::uint32_t> domain;
     // Default controller when a case names no command: the reference controller.
     std::filesystem::path controller_executable = "rig-controller";
+    // The reference controller as a plugin (software-in-the-loop); empty = none
+    // (then the reference controller's keys are not checked before the run).
+    std::filesystem::path controller_plugin;
+    // `rig run --in-process`: every case whose controller can runs in process
+    // (a case's own controller.in_process wins).
+    bool in_process = false;
 };
 
 // Checks that need more than the file itself (e.g. the reference controller's

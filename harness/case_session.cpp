@@ -15,7 +15,9 @@ namespace {
 // The controller's parameters as their own YAML file (the case section minus `command`).
 void write_controller_config(const CaseSpec& spec, const std::filesystem::path& file) {
     YAML::Node section = spec.controller.params.present ? YAML::Clone(spec.controller.params.node) : YAML::Node();
-    if (section.IsMap()) section.remove("command");
+    if (section.IsMap()) {
+        for (std::string_view key : kControllerRigKeys) section.remove(std::string(key));
+    }
     YAML::Emitter out;
     out << section;
     std::ofstream(file) << "# the `controller:` section of " << spec.source_path.string() << "\n"
@@ -119,7 +121,7 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
                                    const std::filesystem::path& case_dir) {
     // The controller under test, in its own process on this run's own domain
     // (none when a real board is wired up: `wiring: { controller: external }`).
-    if (spec.wiring.external_controller || controller_) return;
+    if (spec.wiring.external_controller || controller_ || in_process_) return;
     write_controller_config(spec, case_dir / "controller.yaml");
     std::vector<std::string> argv = spec.controller.command;
     if (argv.empty()) {
@@ -142,11 +144,26 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
     controller_.emplace(argv, controller_log_);
 }
 
+std::string CaseSession::start_in_process_controller(const CaseSpec& spec, const std::filesystem::path& plugin,
+                                                     const std::filesystem::path& case_dir, DdsContext& harness_dds) {
+    write_controller_config(spec, case_dir / "controller.yaml");
+    std::string refusal;
+    in_process_ = InProcessController::make(load_controller_plugin(plugin), case_dir / "controller.yaml",
+                                            case_dir / "controller-state", controller_log_, harness_dds, refusal);
+    return refusal;
+}
+
 CaseSession::~CaseSession() {
     if (controller_) controller_->stop(std::chrono::milliseconds(500));
 }
 
+std::string CaseSession::controller_mode() const {
+    if (in_process_) return "in_process";
+    return controller_ ? "process" : "external";
+}
+
 std::string CaseSession::controller_command_line() const {
+    if (in_process_) return "in process: " + in_process_->plugin_file().string();
     return controller_ ? controller_->command_line() : "external (a wired board)";
 }
 
@@ -159,7 +176,7 @@ std::string CaseSession::stop_controller(std::chrono::milliseconds grace) {
 }
 
 std::string CaseSession::controller_log_tail(std::size_t max_lines) const {
-    return controller_ ? log_tail(controller_log_, max_lines) : std::string();
+    return controller_ || in_process_ ? log_tail(controller_log_, max_lines) : std::string();
 }
 
 std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "harness/case_spec.h"
+#include "harness/in_process_controller.h"
 #include "rig/host/child_process.h"
 #include "rig/runtime/clock.h"
 #include "rig/host/domain_lease.h"
@@ -47,6 +48,15 @@ public:
     // discovery sees the controller's from its first moment.
     void start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
                           const std::filesystem::path& case_dir);
+    // Software-in-the-loop: makes the controller from its plugin, to be stepped
+    // by the lockstep master in this process. Returns the plugin's refusal (this
+    // configuration runs as a process: start_controller then) or "" when made.
+    // Throws std::runtime_error when the plugin cannot make it.
+    std::string start_in_process_controller(const CaseSpec& spec, const std::filesystem::path& plugin,
+                                            const std::filesystem::path& case_dir, DdsContext& harness_dds);
+    InProcessController* in_process_controller() { return in_process_.get(); }
+    // "process", "in_process" or "external": where the controller ran (results.json).
+    std::string controller_mode() const;
     ~CaseSession();
     CaseSession(const CaseSession&) = delete;
     CaseSession& operator=(const CaseSession&) = delete;
@@ -70,6 +80,7 @@ private:
     DomainLease lease_;
     std::filesystem::path controller_log_;
     std::optional<ChildProcess> controller_;
+    std::unique_ptr<InProcessController> in_process_;
     // GNSS pty watch: the unread byte count, and since when it has not gone down.
     std::size_t gnss_unread_ = 0;
     std::optional<WallStopwatch> gnss_unread_since_;

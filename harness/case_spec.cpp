@@ -1,6 +1,7 @@
 #include "harness/case_spec.h"
 
 #include "emulators/land_wheel.h"
+#include "harness/boundary_case.h"
 #include "rig/config/file_access.h"
 #include "rig/runtime/failure_kind.h"
 #include "rig/wire/modbus_protocol.h"
@@ -21,6 +22,10 @@ namespace {
 constexpr EnumChoice<RunMode> kRunModes[] = {
     {"lockstep", RunMode::lockstep},
     {"realtime", RunMode::realtime},
+};
+constexpr EnumChoice<CaseSystem> kSystems[] = {
+    {"breakpoint", CaseSystem::breakpoint},
+    {"boundary", CaseSystem::boundary},
 };
 constexpr EnumChoice<Scenario> kScenarios[] = {
     {"breakpoint_identification", Scenario::breakpoint_identification},
@@ -427,6 +432,12 @@ ControllerSpec read_controller(const YamlSection& root) {
             }
         }
     }
+    if (section.has("plugin")) {
+        const std::string plugin = section.required<std::string>("plugin");
+        if (plugin.empty() || plugin.size() > 4096) section.fail("plugin", "the path of a controller plugin (.so)");
+        controller.plugin = plugin;
+    }
+    if (section.has("in_process")) controller.in_process = section.required<bool>("in_process");
     // The harness judges flow against the target the controller is given
     // (boom-sprayer pumps deliver at most ~200 L/min; see hydraulics).
     if (section.has("target_flow_l_min")) {
@@ -515,6 +526,18 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
         root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
     }
+    if (spec.controller.in_process.value_or(false)) {
+        // In process, the controller is stepped by the lockstep master: there is
+        // no process boundary, so no wall clock and no bench wire to drive it.
+        const YamlSection controller(spec.controller.params);
+        if (spec.mode != RunMode::lockstep || spec.wiring.external_controller) {
+            controller.fail("in_process", "a controller runs in process only in lockstep cases on DDS wires");
+        }
+        if (!spec.controller.command.empty() && spec.controller.plugin.empty()) {
+            controller.fail("in_process", "`command` names a program; a controller runs in process from its "
+                                          "shared library: give `plugin` too");
+        }
+    }
     if (spec.wiring.board_io == BoardIoWireKind::modbus_tcp) {
         try {
             modbus::parse_tcp_endpoint(spec.wiring.modbus_tcp);
@@ -589,13 +612,40 @@ std::string metric_name_problem(std::string_view name) {
 std::map<std::string, double> effective_limits(const CaseSpec& spec, const std::map<std::string, double>& defaults) {
     std::map<std::string, double> limits;
     for (const auto& [name, limit] : defaults) {
-        if (default_limit_applies(spec.scenario, name)) limits[name] = limit;
+        if (spec.system == CaseSystem::breakpoint && default_limit_applies(spec.scenario, name)) limits[name] = limit;
     }
     for (const auto& [name, limit] : spec.limits) limits[name] = limit;
     return limits;
 }
 
 namespace {
+
+// Seed 001's boundary cases: their own sections (harness/boundary_case.h), then
+// the ones every case has. No default limits apply: the case file gives each.
+CaseSpec read_boundary_system_case(const YamlSection& root, CaseSpec spec) {
+    auto boundary = std::make_shared<BoundaryCaseSpec>(read_boundary_case(root));
+    spec.controller = read_controller(root);
+    if (spec.controller.in_process.value_or(false) || !spec.controller.plugin.empty()) {
+        YamlSection(spec.controller.params)
+            .fail(spec.controller.plugin.empty() ? "in_process" : "plugin",
+                  "seed 001's boundary cases run their controller as a program (no in-process mode yet)");
+    }
+    spec.controller.params = controller_section_with_area(spec.controller.params, *boundary);
+    spec.limits = read_limits(root.section("limits"));
+    spec.expect = read_expect(root.section("expect"));
+    spec.timeouts = read_timeouts(root.section("timeouts"));
+    root.finish();
+    if (spec.mode != RunMode::lockstep) root.fail("mode", "boundary cases run in lockstep (no bench wires yet)");
+    check_boundary_case(*boundary, root);
+    for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
+        if (!spec.limits.contains(spec.expect.fail[index])) {
+            throw ConfigError(root.section("expect").item_location("fail", index),
+                              "'" + spec.expect.fail[index] + "' has no limit in this file; expected failures must name limited metrics");
+        }
+    }
+    spec.boundary = std::move(boundary);
+    return spec;
+}
 
 CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_path,
                    const std::map<std::string, double>& default_limits) {
@@ -638,6 +688,8 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     }
     if (root.has("domain")) spec.domain = root.required_in_range<std::uint32_t>("domain", Bounds::closed(0, 232));
     spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
+    spec.system = root.optional_enum<CaseSystem>("system", kSystems, spec.system);
+    if (spec.system == CaseSystem::boundary) return read_boundary_system_case(root, std::move(spec));
     spec.scenario = root.optional_enum<Scenario>("scenario", kScenarios, spec.scenario);
     spec.utc_start_iso = root.optional<std::string>("utc_start", spec.utc_start_iso);
     const auto utc_start = parse_utc(spec.utc_start_iso);

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -26,6 +27,11 @@
 namespace rig::harness {
 
 enum class RunMode { lockstep, realtime };
+// Which system a case tests: seed 000's breakpoint sprayer (the default) or
+// seed 001's per-nozzle boundary shut-off (`system: boundary`, whose own
+// sections are in harness/boundary_case.h).
+enum class CaseSystem { breakpoint, boundary };
+struct BoundaryCaseSpec;
 // What the vehicle and the operator do (harness/case_runner.cpp builds the route):
 //   breakpoint_identification  drive to the breakpoint, stop, press the button,
 //                              come back and approach it again (Tables 3, 4, Fig. 13);
@@ -241,9 +247,17 @@ struct ControllerSpec {
     // The flow the controller is told to hold (its `target_flow_l_min`, 20 L/min if
     // absent); the harness judges flow against the same number.
     double target_flow_l_min = 20.0;
+    // Software-in-the-loop (rig/runtime/node_plugin.h): `plugin`, the controller
+    // built as a shared library (relative to the case file; empty = the
+    // reference controller's, or none for a `command` without one);
+    // `in_process`, whether to run it in the harness's process (unset: as
+    // `rig run --in-process` says). Lockstep cases on DDS wires only.
+    std::filesystem::path plugin;
+    std::optional<bool> in_process;
 };
-// Keys of the controller section that the rig reads itself.
-inline constexpr std::array<std::string_view, 1> kControllerRigKeys = {"command"};
+// Keys of the controller section that the rig reads itself (not written into
+// the controller's configuration file).
+inline constexpr std::array<std::string_view, 3> kControllerRigKeys = {"command", "plugin", "in_process"};
 
 struct ExpectSpec {
     // Metrics that must break their limits (a negative case): the case passes
@@ -281,6 +295,8 @@ struct CaseSpec {
     std::vector<std::uint64_t> seeds;
     std::string source_text;  // the file as written (kept in the trace)
     RunMode mode = RunMode::lockstep;
+    CaseSystem system = CaseSystem::breakpoint;
+    std::shared_ptr<const BoundaryCaseSpec> boundary;  // set for system boundary
     Scenario scenario = Scenario::breakpoint_identification;
     std::string utc_start_iso = "2023-07-15T02:00:00Z";
     // GNSS UTC = utc_start + simulated time.

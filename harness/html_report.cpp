@@ -991,6 +991,13 @@ std::string case_facts(const CaseResult& result) {
         wall += " <span class=\"muted\">(of it start-up " + fixed_number(result.startup_wall_seconds, 3) + " s)</span>";
     }
     row("wall", wall);
+    if (!result.controller_mode.empty()) {
+        std::string placed = html(result.controller_mode == "in_process" ? "in process (plugin)" : result.controller_mode);
+        if (!result.in_process_refused.empty()) {
+            placed += " <span class=\"muted\">(not in process: " + html(result.in_process_refused) + ")</span>";
+        }
+        row("controller", placed);
+    }
     row("trace", result.trace_path.empty() ? std::string("<span class=\"muted\">none</span>")
                                            : "<span class=\"mono\">" + html(result.trace_path) + "</span>");
     row("trace_sha256", result.trace_sha256.empty() ? std::string("<span class=\"muted\">none</span>")

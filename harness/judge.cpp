@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "emulators/field_frame.h"
+#include "harness/boundary_judge.h"
 #include "harness/trace_file.h"
 #include "idl/topics.h"
 
@@ -109,6 +110,7 @@ const std::set<std::string>& judged_topics() {
     static const std::set<std::string> topics = {
         topics::kVehicleTruth,     topics::kHydraulicsTruth,  topics::kSectionValves,
         topics::kBreakpointEvent,  topics::kControllerStatus, topics::kMainFlowMeter,
+        topics::kVehicle2dTruth,   topics::kNozzlesTruth,
     };
     return topics;
 }
@@ -425,6 +427,8 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     }
     result.wall_seconds = run.value("wall_seconds", 0.0);
     result.startup_wall_seconds = run.value("startup_wall_seconds", 0.0);
+    result.controller_mode = run.value("controller_mode", std::string());
+    result.in_process_refused = run.value("in_process_refused", std::string());
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());
     if (run.contains("emission_jitter")) {
         for (const nlohmann::json& device : run.at("emission_jitter")) {
@@ -471,7 +475,8 @@ CaseRun judge_trace(const RecordedTrace& trace) {
     }
     try {
         read_run_facts(trace, result, figures);
-        const JudgingPlan plan = judging_plan_from_json(nlohmann::json::parse(meta_or(trace, "judging", "null")));
+        const nlohmann::json judging = nlohmann::json::parse(meta_or(trace, "judging", "null"));
+        const JudgingPlan plan = judging_plan_from_json(judging);
         result.limits = plan.limits;
         result.expected_error = plan.expect_error;
         figures.breakpoint_along_m = plan.breakpoint_along_m;
@@ -516,6 +521,8 @@ CaseRun judge_trace(const RecordedTrace& trace) {
             metrics.merge(deposition.metrics);
             add_dose_figure(trace.dose, deposition, plan.breakpoint_along_m, plan.deposition.cv_window_m, figures);
         }
+        // Seed 001's boundary cases (harness/boundary_judge.h).
+        if (plan.scenario == "boundary") metrics.merge(boundary_trace_metrics(trace, boundary_judging_plan_from_json(judging.at("boundary"))));
         result.metrics = metrics.values;
         result.not_measured = metrics.not_measured;
 

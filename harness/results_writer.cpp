@@ -429,7 +429,9 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"wall_seconds", result.wall_seconds},
             {"startup_wall_seconds", result.startup_wall_seconds},
             {"mode", valid_utf8(result.mode)},
+            {"controller_mode", valid_utf8(result.controller_mode)},
         };
+        if (!result.in_process_refused.empty()) one_case["in_process_refused"] = valid_utf8(result.in_process_refused);
         if (result.mode == "realtime") {
             nlohmann::json jitter = nlohmann::json::object();
             for (const EmissionJitter& device : result.emission_jitter) {

@@ -43,6 +43,10 @@ struct CaseResult {
     double wall_seconds = 0.0;
     double startup_wall_seconds = 0.0;  // of wall_seconds: process start, DDS discovery, hello
     std::string mode = "lockstep";      // or "realtime"
+    // Where the controller ran: "process", "in_process" (a plugin, software-in-the-loop)
+    // or "external" (a wired board); empty in traces from before it was recorded.
+    std::string controller_mode;
+    std::string in_process_refused;  // in process was asked for; why it ran as a process
     // Real-time runs only: what scheduling the rig got, and the emission jitter per device.
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;

@@ -103,4 +103,47 @@ nlohmann::json to_json(const msg::VehicleTruth& sample) {
             {"pass_index", sample.pass_index()}};
 }
 
+nlohmann::json to_json(const msg::SerialLine& sample) {
+    std::string text = sample.text().to_string();
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    return {{"text", text}};
+}
+
+nlohmann::json to_json(const msg::NozzlePwm& sample) {
+    return {{"frequency_hz", sample.frequency_hz()}, {"duty_pct", sample.duty_pct()}};
+}
+
+nlohmann::json to_json(const msg::Vehicle2dTruth& sample) {
+    return {{"time_ns", sample.time_ns()},
+            {"east_m", sample.east_m()},
+            {"north_m", sample.north_m()},
+            {"heading_deg", sample.heading_deg()},
+            {"speed_m_s", sample.speed_m_s()},
+            {"yaw_rate_deg_s", sample.yaw_rate_deg_s()},
+            {"antenna_east_m", sample.antenna_east_m()},
+            {"antenna_north_m", sample.antenna_north_m()},
+            {"antenna_lat_deg", sample.antenna_lat_deg()},
+            {"antenna_lon_deg", sample.antenna_lon_deg()},
+            {"antenna_height_m", sample.antenna_height_m()},
+            {"antenna_velocity_east_m_s", sample.antenna_velocity_east_m_s()},
+            {"antenna_velocity_north_m_s", sample.antenna_velocity_north_m_s()},
+            {"boom_height_m", sample.boom_height_m()},
+            {"boom_offset_m", sample.boom_offset_m()},
+            {"boom_centre_east_m", sample.boom_centre_east_m()},
+            {"boom_centre_north_m", sample.boom_centre_north_m()}};
+}
+
+nlohmann::json to_json(const msg::NozzlesTruth& sample) {
+    nlohmann::json nozzles = nlohmann::json::array();
+    for (const msg::NozzleTruth& n : sample.nozzles()) {
+        nozzles.push_back({{"east_m", n.east_m()},
+                           {"north_m", n.north_m()},
+                           {"duty_pct", n.duty_pct()},
+                           {"opening", n.opening()},
+                           {"flow_l_min", n.flow_l_min()},
+                           {"delivered_l", n.delivered_l()}});
+    }
+    return {{"time_ns", sample.time_ns()}, {"nozzles", std::move(nozzles)}};
+}
+
 }  // namespace rig::harness

@@ -19,6 +19,11 @@ nlohmann::json to_json(const msg::HydraulicsTruth& sample);
 nlohmann::json to_json(const msg::ControllerStatus& sample);
 nlohmann::json to_json(const msg::BreakpointEvent& sample);
 nlohmann::json to_json(const msg::VehicleTruth& sample);
+// Seed 001's wires and truth.
+nlohmann::json to_json(const msg::SerialLine& sample);
+nlohmann::json to_json(const msg::NozzlePwm& sample);
+nlohmann::json to_json(const msg::Vehicle2dTruth& sample);
+nlohmann::json to_json(const msg::NozzlesTruth& sample);
 const char* to_string(msg::BreakpointEventKind kind);
 const char* to_string(msg::SprayPhase phase);
 

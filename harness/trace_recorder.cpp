@@ -50,6 +50,13 @@ TraceRecorder::TraceRecorder(DdsContext& dds, const std::filesystem::path& file)
     add_channel<msg::BreakpointEvent>(dds, topics::kBreakpointEvent);
 }
 
+void TraceRecorder::record_boundary_topics() {
+    add_channel<msg::SerialLine>(dds_, topics::kLaserHeightSerial);
+    add_channel<msg::NozzlePwm>(dds_, topics::kNozzlePwm);
+    add_channel<msg::Vehicle2dTruth>(dds_, topics::kVehicle2dTruth);
+    add_channel<msg::NozzlesTruth>(dds_, topics::kNozzlesTruth);
+}
+
 bool TraceRecorder::records(const std::string& topic) const {
     return std::any_of(channels_.begin(), channels_.end(), [&](const Channel& channel) { return channel.topic == topic; });
 }
@@ -105,7 +112,7 @@ void TraceRecorder::drain(TimeNs t, int round) {
         channel.take(taken);
         const bool rig_only = rig_only_topic(channel.topic);
         for (const auto& [json, writer] : taken) {
-            if (rig_only && !dds_.same_process(writer)) {
+            if (rig_only && !dds_.is_rig_participant(writer)) {
                 const std::string participant = dds_.participant_name(writer);
                 file_.append_foreign(t, round, channel.topic, participant, writer, json);
                 foreign_.push_back(ForeignSample{t, channel.topic, participant, writer});

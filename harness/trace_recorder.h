@@ -46,6 +46,9 @@ public:
     // {"cdr_hex": "..."}; meta `own_topic:TOPIC` says the type. Channels added
     // this way are drained after the known ones, in the order added.
     void record_raw(const std::string& topic, const std::string& type_name);
+    // Seed 001's topics (boundary cases): the AD300's and L4's lines, the PWM
+    // duties, the 2-D plant's truth. Drained after the fixed ones, in this order.
+    void record_boundary_topics();
 
 private:
     struct Channel {

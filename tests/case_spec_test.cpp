@@ -527,10 +527,11 @@ std::vector<std::string> known_keys_of(const std::function<void(const std::strin
 // Keys that are not numbers: a number in their place is a type error, or (for
 // the strings) a legal value; everything else must have a range.
 bool is_non_numeric_key(const std::string& key) {
-    // (`seed` is any 64-bit number; `command` is the rig's, read by the harness.)
+    // (`seed` is any 64-bit number; `command`, `plugin` and `in_process` are the
+    // rig's, read by the harness.)
     static const std::vector<std::string> strings = {"name",       "description",           "gnss_port", "modbus_port",
                                                      "modbus_tcp", "breakpoint_store_file", "seed",      "command",
-                                                     "diagnostics_topic"};
+                                                     "plugin",     "in_process",            "diagnostics_topic"};
     return std::find(strings.begin(), strings.end(), key) != strings.end();
 }
 

@@ -26,6 +26,23 @@ struct TargetAreaConfig {
     double density = 0.5;
 };
 
+// TEST-ONLY faults (the catalogue of faulty seed-001 controllers, cases/
+// seed001-faulty-controllers/): each is a mistake a real implementation of
+// Sec. 4.2 could make, so the rig must catch it on its named metric. All off
+// by default; the reference controller never sets them.
+struct BoundaryControllerFaults {
+    // Added to Eq. 18's Y1 (boom centre ahead of the antenna): an antenna
+    // mounted elsewhere than the controller believes. [-5, 5] m.
+    double antenna_offset_error_m = 0.0;
+    // Eq. 19 without the rotation by the course: the boom taken as if the
+    // vehicle always headed grid north.
+    bool no_course_rotation = false;
+    // The L4 laser's readings dropped: Eq. 18 at default_boom_height_m always.
+    bool ignore_boom_height = false;
+    // The look-ahead points taken behind the antenna instead of ahead.
+    bool lookahead_sign_flipped = false;
+};
+
 struct BoundaryControllerConfig {
     std::vector<TargetAreaConfig> areas;  // >= 1; the UTM zone is that of the corners' mean
 
@@ -72,6 +89,8 @@ struct BoundaryControllerConfig {
     // The paper uses the RMC course (true north) as the bearing in UTM (Eq. 19),
     // ignoring the grid convergence (about 1.3 deg at Wuzhi): false reproduces that.
     bool correct_grid_convergence = false;
+
+    BoundaryControllerFaults faults;
 };
 
 // Throws std::invalid_argument "boundary.<key>: <what>" for the first value

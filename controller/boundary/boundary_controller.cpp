@@ -105,6 +105,8 @@ void BoundaryController::on_laser_line(std::string_view line, TimeNs /*now_ns*/)
         }
         return;
     }
+    // TEST-ONLY fault: a controller that never uses the laser.
+    if (config_.faults.ignore_boom_height) return;
     const double h_m = *reading.distance_m - config_.laser_mount_offset_m;
     const double lo = config_.lift_hinge_height_m - config_.lift_rod_length_m;
     const double hi = config_.lift_hinge_height_m + config_.lift_rod_length_m;
@@ -135,13 +137,17 @@ void BoundaryController::decide() {
         all_off();
         return;
     }
+    const BoundaryControllerFaults& faults = config_.faults;  // TEST-ONLY, all off in the reference
     const double bearing_deg =
-        *status_.course_deg - (config_.correct_grid_convergence ? status_.convergence_deg : 0.0);
+        faults.no_course_rotation
+            ? 0.0
+            : *status_.course_deg - (config_.correct_grid_convergence ? status_.convergence_deg : 0.0);
     double sin_b = 0.0;
     double cos_b = 1.0;
     GeographicLib::Math::sincosd(bearing_deg, sin_b, cos_b);
     const double v = status_.speed_m_s;
-    const double y1 = status_.boom_offset_m;
+    const double y1 = status_.boom_offset_m + faults.antenna_offset_error_m;
+    const double lookahead_sign = faults.lookahead_sign_flipped ? -1.0 : 1.0;
     // A body point (x right, Y1 forward) tau seconds ahead, straight on along the course.
     const auto point = [&](double x_m, double tau_s) {
         const GridPoint ahead{status_.antenna.x_m + v * tau_s * sin_b, status_.antenna.y_m + v * tau_s * cos_b};
@@ -155,8 +161,8 @@ void BoundaryController::decide() {
             area = now_area;
             return now_area >= 0;
         }
-        int ahead = area_of(point(x_m, config_.lookahead_on_s));
-        if (ahead < 0 && was_inside) ahead = area_of(point(x_m, config_.lookahead_off_s));
+        int ahead = area_of(point(x_m, lookahead_sign * config_.lookahead_on_s));
+        if (ahead < 0 && was_inside) ahead = area_of(point(x_m, lookahead_sign * config_.lookahead_off_s));
         area = now_area >= 0 ? now_area : ahead;
         return ahead >= 0;
     };

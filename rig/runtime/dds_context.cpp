@@ -258,7 +258,7 @@ std::vector<DiscoveredEndpoint> DdsContext::take_discoveries() {
     if (!discovery_) return taken;
     std::lock_guard lock(discovery_->mutex);
     for (DiscoveredEndpoint& endpoint : discovery_->pending) {
-        if (same_process(endpoint.guid_prefix)) continue;  // the rig's own endpoints
+        if (is_rig_participant(endpoint.guid_prefix)) continue;  // the rig's own endpoints
         // A participant's name may have been announced after its first endpoint.
         if (endpoint.participant == "?") {
             if (const auto name = discovery_->names.find(endpoint.guid_prefix); name != discovery_->names.end()) {
@@ -271,10 +271,17 @@ std::vector<DiscoveredEndpoint> DdsContext::take_discoveries() {
     return taken;
 }
 
-bool DdsContext::same_process(const std::string& guid_prefix) const {
+bool DdsContext::is_rig_participant(const std::string& guid_prefix) const {
     // Fast DDS prefixes: 2 bytes vendor, 2 bytes host, 4 bytes process, 4 bytes participant.
     constexpr std::size_t kProcessHexDigits = 16;
-    return guid_prefix.compare(0, kProcessHexDigits, guid_prefix_, 0, kProcessHexDigits) == 0;
+    if (guid_prefix.compare(0, kProcessHexDigits, guid_prefix_, 0, kProcessHexDigits) != 0) return false;
+    std::lock_guard lock(guests_mutex_);
+    return std::find(guest_prefixes_.begin(), guest_prefixes_.end(), guid_prefix) == guest_prefixes_.end();
+}
+
+void DdsContext::add_guest_participant(const std::string& guid_prefix) {
+    std::lock_guard lock(guests_mutex_);
+    guest_prefixes_.push_back(guid_prefix);
 }
 
 std::string DdsContext::participant_name(const std::string& guid_prefix) const {

@@ -173,10 +173,15 @@ public:
     std::uint32_t domain_id() const { return domain_id_; }
     // This participant's GUID prefix (hex), as Reader::take_all_with_writer reports writers.
     const std::string& guid_prefix() const { return guid_prefix_; }
-    // Whether a participant's GUID prefix is of this process (its first 8 bytes,
-    // vendor, host and process, are ours): the rig's own participants, whichever
-    // case or domain they serve, never count as a controller's.
-    bool same_process(const std::string& guid_prefix) const;
+    // Whether a participant is the rig's own: its GUID prefix is of this process
+    // (the first 8 bytes, vendor, host and process, are ours), whichever case or
+    // domain it serves, and it is not a guest. Samples and endpoints of the
+    // rig's own participants never count as a controller's.
+    bool is_rig_participant(const std::string& guid_prefix) const;
+    // A participant in this process that is not the rig's: a controller plugin
+    // run in process (rig/runtime/node_plugin.h). Its endpoints and samples are
+    // judged as a controller process's are.
+    void add_guest_participant(const std::string& guid_prefix);
     // Endpoints of participants of other processes discovered or removed since the
     // last call, in the order discovery reported them (empty unless watch_discovery).
     std::vector<DiscoveredEndpoint> take_discoveries();
@@ -235,6 +240,8 @@ private:
     std::uint32_t domain_id_;
     std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
     std::string guid_prefix_;
+    mutable std::mutex guests_mutex_;
+    std::vector<std::string> guest_prefixes_;
     dds::DomainParticipant* participant_ = nullptr;
     dds::Publisher* publisher_ = nullptr;
     dds::Subscriber* subscriber_ = nullptr;

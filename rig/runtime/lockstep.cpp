@@ -83,16 +83,53 @@ LockstepMaster::~LockstepMaster() { shutdown(); }
 void LockstepMaster::add_local_node(Node& node) { locals_.push_back(Local{&node, 0}); }
 
 void LockstepMaster::add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness) {
-    remotes_.push_back(Remote{name, std::move(liveness), 0, {}, {}, {}});
+    Remote remote;
+    remote.name = name;
+    remote.liveness = std::move(liveness);
+    remotes_.push_back(std::move(remote));
+}
+
+void LockstepMaster::add_in_process_node(Node& node, DdsContext& node_dds) {
+    Remote remote;
+    remote.name = node.name();
+    remote.in_process = &node;
+    remote.in_process_dds = &node_dds;
+    remotes_.push_back(std::move(remote));
+}
+
+std::size_t LockstepMaster::process_remote_count() const {
+    return static_cast<std::size_t>(
+        std::count_if(remotes_.begin(), remotes_.end(), [](const Remote& remote) { return remote.in_process == nullptr; }));
+}
+
+void LockstepMaster::wait_in_process_matched(const Remote& remote,
+                                             const std::function<void(const std::string&)>& check_startup) {
+    // As a follower process before its hello: a reader no one writes is a
+    // configuration error, reported with the node's name when the bound passes.
+    for (ReaderBase* reader : remote.in_process_dds->readers()) {
+        while (reader->matched_writers() < 1) {
+            check_startup("node '" + remote.name + "': a writer for the topic it reads, " + reader->topic_name());
+            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+        }
+    }
 }
 
 void LockstepMaster::start() {
     tick_writer_ = std::make_unique<Writer<msg::ClockTick>>(dds_, topics::kClockTick, false);
     ack_reader_ = std::make_unique<Reader<msg::ClockAck>>(dds_, topics::kClockAck);
     for (Local& local : locals_) local.node->configure(dds_);
+    for (Remote& remote : remotes_) {
+        if (remote.in_process == nullptr) continue;
+        try {
+            remote.in_process->configure(*remote.in_process_dds);
+            remote.configured = true;
+        } catch (const std::exception& error) {
+            throw NodeFailure(FailureKind::node_fatal_error, remote.name, std::string("configure failed: ") + error.what());
+        }
+    }
 
     const WallStopwatch waited;
-    auto check_startup = [&](const std::string& what) {
+    const std::function<void(const std::string&)> check_startup = [&](const std::string& what) {
         if (watchdog_) watchdog_();
         for (const Remote& remote : remotes_) {
             if (auto gone = remote.liveness ? remote.liveness() : std::nullopt) throw NodeFailure(FailureKind::node_exited, remote.name, *gone);
@@ -106,10 +143,13 @@ void LockstepMaster::start() {
     };
 
     if (!remotes_.empty()) {
-        const int expected = static_cast<int>(remotes_.size());
+        const int expected = static_cast<int>(process_remote_count());
         while (tick_writer_->matched_readers() < expected || ack_reader_->matched_writers() < expected) {
             check_startup("DDS discovery of the clock topics");
             ack_reader_->wait_for_data(kPollSlice);
+        }
+        for (const Remote& remote : remotes_) {
+            if (remote.in_process != nullptr) wait_in_process_matched(remote, check_startup);
         }
         // Hello: seq 0.
         tick_remotes(0, false);
@@ -214,16 +254,25 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
     tick.seq(seq_);
     tick.time_ns(t);
     tick.shutdown(shutdown);
-    fill_counts(all_published_counts(), tick.published_counts());
+    const TopicCounts published_before = all_published_counts();
+    fill_counts(published_before, tick.published_counts());
     if (seq_ == 1) fill_counts(reader_counts(), tick.reader_counts());
     const std::uint64_t seq = seq_++;
-    tick_writer_->publish(tick);
+    std::size_t outstanding = process_remote_count();
+    if (outstanding > 0) tick_writer_->publish(tick);
 
     const bool hello = seq == 0;
     const auto limit = hello ? timeouts_.startup : timeouts_.ack;
     std::vector<bool> answered(remotes_.size(), false);
-    std::size_t outstanding = remotes_.size();
     std::uint32_t published = 0;
+    // In-process nodes take the tick here, with the counts it carries: they see
+    // what a follower process would see, no more (what they publish now is not
+    // counted for the processes answering this same tick, as between processes).
+    for (std::size_t i = 0; i < remotes_.size(); ++i) {
+        if (remotes_[i].in_process == nullptr) continue;
+        answered[i] = true;
+        published += step_in_process(remotes_[i], seq, t, shutdown, published_before);
+    }
     const WallStopwatch waited;
     WallStopwatch since_hello;
     while (outstanding > 0) {
@@ -273,6 +322,78 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
     return published;
 }
 
+std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq, TimeNs t, bool shutdown,
+                                              const TopicCounts& published_before) {
+    DdsContext& node_dds = *remote.in_process_dds;
+    Node& node = *remote.in_process;
+    if (seq == 0) {
+        // The hello's answer: the topics it reads and writes.
+        remote.subscribed_topics.clear();
+        remote.published_topics.clear();
+        for (ReaderBase* reader : node_dds.readers()) remote.subscribed_topics.push_back(reader->topic_name());
+        for (WriterBase* writer : node_dds.writers()) remote.published_topics.push_back(writer->topic_name());
+        remote.next_wake_ns = 0;
+        return 0;
+    }
+    if (shutdown) {
+        remote.shut_down = true;
+        remote.next_wake_ns = kNever;
+        try {
+            node.shutdown();
+        } catch (const std::exception& error) {
+            throw NodeFailure(FailureKind::node_fatal_error, remote.name, std::string("shutdown: ") + error.what());
+        }
+        return 0;
+    }
+    // Counted delivery, as a follower: everything published so far is in its
+    // readers before it takes its inputs.
+    const WallStopwatch waited;
+    for (;;) {
+        const auto short_topics = node_dds.wait_received(published_before, kPollSlice);
+        if (short_topics.empty()) break;
+        if (watchdog_) watchdog_();
+        check_remotes_alive(t);
+        if (waited.elapsed() > timeouts_.delivery) {
+            throw NodeFailure(FailureKind::delivery_timeout, remote.name,
+                              "samples on " + join(short_topics) + " published by t=" + format_time(t) +
+                                  " did not arrive within " + std::to_string(timeouts_.delivery.count()) + " ms");
+        }
+    }
+    node_dds.take_published_count();
+    if (!remote.activated) {
+        // Its writers reach every reader of their topics before it first
+        // publishes (the first tick's reader counts, lockstep.h).
+        const TopicCounts readers = reader_counts();
+        const WallStopwatch matching;
+        for (WriterBase* writer : node_dds.writers()) {
+            const auto it = readers.find(writer->topic_name());
+            if (it == readers.end()) continue;
+            while (static_cast<std::uint64_t>(writer->matched_readers()) < it->second) {
+                if (watchdog_) watchdog_();
+                if (matching.elapsed() > timeouts_.startup) {
+                    throw NodeFailure(FailureKind::startup_timeout, remote.name,
+                                      "its writer of " + writer->topic_name() + " reached " +
+                                          std::to_string(writer->matched_readers()) + " of " +
+                                          std::to_string(it->second) + " readers within " +
+                                          std::to_string(timeouts_.startup.count()) + " ms");
+                }
+                ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+            }
+        }
+    }
+    try {
+        if (!remote.activated) {
+            node.activate(t);
+            remote.activated = true;
+        }
+        remote.next_wake_ns = node.step(t);
+    } catch (const std::exception& error) {
+        throw NodeFailure(FailureKind::node_fatal_error, remote.name, error.what());
+    }
+    remote.published_counts = node_dds.written_counts();
+    return node_dds.take_published_count();
+}
+
 std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
     if (!started_) throw std::logic_error("LockstepMaster::advance before start");
     TimeNs t = kNever;
@@ -320,7 +441,7 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
 void LockstepMaster::shutdown(bool after_failure) noexcept {
     if (shut_down_) return;
     shut_down_ = true;
-    if (started_ && !remotes_.empty()) {
+    if (started_ && process_remote_count() > 0) {
         try {
             if (after_failure) {
                 msg::ClockTick tick;
@@ -333,6 +454,17 @@ void LockstepMaster::shutdown(bool after_failure) noexcept {
             }
         } catch (const std::exception& error) {
             std::cerr << "rig: during shutdown: " << error.what() << "\n";
+        }
+    }
+    // In-process nodes the shutdown tick did not reach (a failed run, or a run
+    // with no process to tick) still end like a follower told to stop.
+    for (Remote& remote : remotes_) {
+        if (remote.in_process == nullptr || !remote.configured || remote.shut_down) continue;
+        remote.shut_down = true;
+        try {
+            remote.in_process->shutdown();
+        } catch (const std::exception& error) {
+            std::cerr << "rig: shutting down node '" << remote.name << "': " << error.what() << "\n";
         }
     }
     for (auto it = locals_.rbegin(); it != locals_.rend(); ++it) {

@@ -80,6 +80,13 @@ public:
     // A remote node (its own process). `liveness` returns an error text when the
     // node is known to be gone (e.g. its process exited), checked while waiting.
     void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
+    // A node run in this process on a DDS participant of its own (a controller
+    // plugin, rig/runtime/node_plugin.h), in place of a remote: it is configured,
+    // says hello, waits for counted delivery, activates and steps exactly where a
+    // follower process would, only called instead of ticked. Same order, same
+    // inputs at each step: the same trace as process mode. `node_dds` must
+    // outlive the master's shutdown.
+    void add_in_process_node(Node& node, DdsContext& node_dds);
     // Called after every round with (t, round): the recorder drains its readers here.
     void set_after_round(std::function<void(TimeNs, int)> callback) { after_round_ = std::move(callback); }
     // Called in every wall-time slice the master waits (start-up, acknowledgements,
@@ -123,6 +130,12 @@ private:
         std::vector<std::string> subscribed_topics;
         std::vector<std::string> published_topics;
         TopicCounts published_counts;  // cumulative, from its latest ack
+        // In process (add_in_process_node): stepped by the master, no clock topics.
+        Node* in_process = nullptr;
+        DdsContext* in_process_dds = nullptr;
+        bool configured = false;
+        bool activated = false;
+        bool shut_down = false;
     };
     struct Local {
         Node* node;
@@ -136,6 +149,14 @@ private:
     TopicCounts reader_counts() const;
     // Until the local readers hold all of it (bounded; a dead remote is named).
     void wait_local_readers(TimeNs t);
+    // What a follower process does on a tick, for an in-process node; returns
+    // the samples it published.
+    std::uint32_t step_in_process(Remote& remote, std::uint64_t seq, TimeNs t, bool shutdown,
+                                  const TopicCounts& published_before);
+    // Before its hello: every reader of an in-process node has a writer (as a
+    // follower's wait_matched), within the start-up bound.
+    void wait_in_process_matched(const Remote& remote, const std::function<void(const std::string&)>& check_startup);
+    std::size_t process_remote_count() const;
 
     DdsContext& dds_;
     LockstepTimeouts timeouts_;

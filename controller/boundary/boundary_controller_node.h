@@ -1,0 +1,45 @@
+#pragma once
+// Seed 001's reference controller as a rig node on DDS: what the paper's
+// Raspberry Pi does (Sec. 1.1, 4.2), with DDS topics as its wires. It reads the
+// AD300's RMC lines and the L4 laser's serial lines, hands them to the logic
+// (boundary_controller.h), and publishes the PWM duty of every nozzle when it
+// changes. It never sees truth.
+//
+// Subscriptions: device/gnss/nmea, device/laser_height/serial
+// Publications:  actuator/nozzle_pwm/duty
+// With a `calibration:` sweep (boundary_node_config.h) it holds the sweep's
+// duties on every nozzle instead, as the paper's Table 3 measurement did.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "controller/boundary/boundary_controller.h"
+#include "controller/boundary/boundary_node_config.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
+
+namespace rig::controller::boundary {
+
+class BoundaryControllerNode final : public Node {
+public:
+    BoundaryControllerNode(std::string node_name, BoundaryNodeConfig config);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override;
+
+private:
+    // The sweep's duty at now_ns and when it next changes.
+    double sweep_duty_pct(TimeNs now_ns, TimeNs& next_change_ns) const;
+
+    std::string name_;
+    DutySweepConfig sweep_;
+    BoundaryController logic_;
+    std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
+    std::unique_ptr<Reader<msg::SerialLine>> laser_reader_;
+    std::unique_ptr<Writer<msg::NozzlePwm>> pwm_writer_;
+    std::vector<double> published_duty_pct_;
+    bool published_once_ = false;
+};
+
+}  // namespace rig::controller::boundary

@@ -1,0 +1,97 @@
+#include "controller/boundary/boundary_node_config.h"
+
+#include <stdexcept>
+
+namespace rig::controller::boundary {
+namespace {
+
+// Every numeric key is read unbounded here (finite) and held to the bounds
+// declared beside the field by validate(): the bounds live in one place.
+const Bounds kFinite = Bounds::closed(-1e9, 1e9);
+
+void read_double(const YamlSection& s, const char* key, double& value) {
+    value = s.optional_in_range<double>(key, value, kFinite);
+}
+
+TargetAreaConfig read_area(const YamlSection& s) {
+    TargetAreaConfig area;
+    area.name = s.required<std::string>("name");
+    for (const YamlSection& corner : s.list("corners")) {
+        area.corners.push_back(GeoCorner{corner.required_in_range<double>("lat_deg", Bounds::closed(-80, 84)),
+                                         corner.required_in_range<double>("lon_deg", Bounds::closed(-180, 180))});
+    }
+    area.density = s.optional_in_range<double>("density", area.density, Bounds::closed(0, 1));
+    return area;
+}
+
+}  // namespace
+
+BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
+    BoundaryNodeConfig node;
+    BoundaryControllerConfig& c = node.controller;
+    section.allow("command");  // the rig's key (kControllerRigKeys)
+    for (const YamlSection& area : section.list("areas")) c.areas.push_back(read_area(area));
+    c.nozzle_count = section.optional_in_range<int>("nozzle_count", c.nozzle_count, Bounds::closed(1, 32));
+    read_double(section, "nozzle_spacing_m", c.nozzle_spacing_m);
+    read_double(section, "lift_rod_length_m", c.lift_rod_length_m);
+    read_double(section, "lift_hinge_height_m", c.lift_hinge_height_m);
+    read_double(section, "antenna_to_o_m", c.antenna_to_o_m);
+    read_double(section, "hinge_to_boom_centre_m", c.hinge_to_boom_centre_m);
+    read_double(section, "boom_centre_right_of_antenna_m", c.boom_centre_right_of_antenna_m);
+    read_double(section, "laser_mount_offset_m", c.laser_mount_offset_m);
+    read_double(section, "default_boom_height_m", c.default_boom_height_m);
+    read_double(section, "k_max_cover", c.k_max_cover);
+    read_double(section, "eq12_coefficient_l_min_per_m_s", c.eq12_coefficient_l_min_per_m_s);
+    read_double(section, "eq13_slope_l_min_per_pct", c.eq13_slope_l_min_per_pct);
+    read_double(section, "eq13_intercept_l_min", c.eq13_intercept_l_min);
+    read_double(section, "level0_max_pct", c.level0_max_pct);
+    read_double(section, "level1_max_pct", c.level1_max_pct);
+    read_double(section, "level1_duty_pct", c.level1_duty_pct);
+    read_double(section, "level2_duty_pct", c.level2_duty_pct);
+    read_double(section, "pwm_frequency_hz", c.pwm_frequency_hz);
+    c.lookahead_enabled = section.optional<bool>("lookahead_enabled", c.lookahead_enabled);
+    read_double(section, "lookahead_on_s", c.lookahead_on_s);
+    read_double(section, "lookahead_off_s", c.lookahead_off_s);
+    read_double(section, "course_hold_speed_m_s", c.course_hold_speed_m_s);
+    read_double(section, "fix_timeout_s", c.fix_timeout_s);
+    c.correct_grid_convergence = section.optional<bool>("correct_grid_convergence", c.correct_grid_convergence);
+
+    const YamlSection faults = section.section("faults");
+    read_double(faults, "antenna_offset_error_m", c.faults.antenna_offset_error_m);
+    c.faults.no_course_rotation = faults.optional<bool>("no_course_rotation", false);
+    c.faults.ignore_boom_height = faults.optional<bool>("ignore_boom_height", false);
+    c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
+
+    const YamlSection sweep = section.section("calibration");
+    const std::vector<std::string> duties = sweep.string_list("duties_pct");
+    for (std::size_t i = 0; i < duties.size(); ++i) {
+        const std::string& text = duties[i];
+        double duty = 0.0;
+        try {
+            std::size_t used = 0;
+            duty = std::stod(text, &used);
+            if (used != text.size()) throw std::invalid_argument(text);
+        } catch (const std::exception&) {
+            throw ConfigError(sweep.item_location("duties_pct", i), "a duty in %, got '" + text + "'");
+        }
+        if (!(duty >= 0.0 && duty <= 100.0)) {
+            throw ConfigError(sweep.item_location("duties_pct", i), "a duty must be in [0, 100] %, got " + text);
+        }
+        node.calibration.duties_pct.push_back(duty);
+    }
+    node.calibration.start_s = sweep.optional_in_range<double>("start_s", node.calibration.start_s, Bounds::closed(0, 3600));
+    node.calibration.hold_s = sweep.optional_in_range<double>("hold_s", node.calibration.hold_s, Bounds::open_closed(0, 3600));
+    section.finish();
+    try {
+        validate(c);
+    } catch (const std::invalid_argument& error) {
+        section.fail(error.what());
+    }
+    return node;
+}
+
+BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file) {
+    return parse_boundary_node_config(YamlSection::load_file(file));
+}
+
+}  // namespace rig::controller::boundary

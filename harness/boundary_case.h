@@ -1,0 +1,88 @@
+#pragma once
+// Seed 001's boundary cases (`system: boundary`): the part of a case file that
+// is not seed 000's. The loader (harness/case_spec.cpp) reads the keys every
+// case has (name, seed(s), domain, mode, controller, limits, expect, timeouts)
+// and hands the rest to read_boundary_case here.
+//
+//   field:    { origin: { lat_deg, lon_deg, height_m } }   the local ENU frame's origin (plant truth)
+//   area:     { name, density, corners: [ { lat_deg, lon_deg } x 4 ] }   the target area (Sec. 4.2.2)
+//   route:    { start: { east_m, north_m, heading_deg, speed_m_s },
+//               segments: [ { straight: {...} } | { turn: {...} } | { stand: {...} } ] }
+//   sprayer:  mounting (antenna, nozzles, Eq. 18's lift) and boom_height: [ { t_s, height_m } ]
+//   spray:    fan and deposition step; flow_table: per nozzle [ { duty_pct, flow_ml_min } ] (Table 3 by default)
+//   valves:   PWM valves; ad300: the receiver; laser: the L4
+//   judge:    ground grid, wet threshold, the edges to measure and the metric
+//             each gives, flow per duty (Table 3)
+// Every parameter is declared once, in the emulator's own parameter struct
+// (emulators/ad300_receiver.h, l4_laser_sensor.h, pwm_nozzle_valves.h,
+// boundary_spray_plant.h, field2d/*), with unit, default and provenance; the
+// case file overrides it by the same name, and the emulator's own checks give
+// the bounds (reported at the key's section as a rig::ConfigError).
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "emulators/ad300_receiver.h"
+#include "emulators/boundary_spray_plant.h"
+#include "emulators/field2d/deposition_grid2d.h"
+#include "emulators/field2d/local_frame.h"
+#include "emulators/field2d/nozzle_flow_table.h"
+#include "emulators/field2d/route2d.h"
+#include "emulators/field2d/sprayer_kinematics.h"
+#include "emulators/l4_laser_sensor.h"
+#include "emulators/pwm_nozzle_valves.h"
+#include "harness/boundary_metrics.h"
+#include "rig/config/yaml_fields.h"
+
+namespace rig::harness {
+
+// The metric families a boundary edge can be judged for (harness/boundary_metrics.h).
+inline constexpr std::string_view kBoundaryEdgeMetrics[] = {"boundary_overrun", "drive_out_excess", "drive_in_excess"};
+
+// One edge of the target area measured every spacing_m, its excess named `metric`.
+struct BoundaryEdgeJudging {
+    std::string metric;                    // one of kBoundaryEdgeMetrics
+    field2d::Vec2 near;                    // the area edge whose midpoint is nearest this point (local frame, m)
+    EdgeProbe probe;                       // stations along the edge from its first corner (counter-clockwise)
+};
+
+struct BoundaryCaseSpec {
+    field2d::GeodeticPoint origin;         // ENU origin; lat [-80, 84], lon [-180, 180], height [-1000, 10000] m
+    std::string area_name = "target";
+    std::vector<field2d::GeodeticPoint> corners;  // >= 3 (the paper records 4)
+    double area_density = 0.5;             // plant cover D in [0, 1] the controller is told (Eq. 17); until the vision half
+    field2d::RouteStart route_start;
+    std::vector<field2d::RouteSegment> route_segments;
+    field2d::SprayerMounting mounting;
+    std::vector<field2d::HeightKnot> boom_height{field2d::HeightKnot{0.0, 0.5}};
+    emulators::SprayDepositionParams spray;
+    std::vector<std::vector<field2d::FlowPoint>> flow_table;  // empty: Table 3 as printed
+    emulators::PwmValveParams valves;      // seed: the run's
+    emulators::Ad300Params ad300;          // seed: the run's
+    emulators::L4LaserParams laser;        // seed: the run's
+    // Judging.
+    field2d::DepositionGrid2dParams ground;  // the judge's grid, rebuilt from the trace
+    double wet_threshold_ul_cm2 = EdgeProbe{}.wet_threshold_ul_cm2;
+    std::vector<BoundaryEdgeJudging> edges;
+    bool judge_flow_per_duty = false;      // Table 3: flow per duty per nozzle from the delivered volumes
+    // Flow per duty skips this long after each duty change (the first PWM periods).
+    double flow_settle_s = 0.5;            // [0, 60]
+    double end_after_route_s = 1.0;        // the run ends this long after the route does, [0, 600]
+
+    field2d::NozzleFlowTable flow_table_or_paper() const;
+    field2d::LocalFrame frame() const { return field2d::LocalFrame(origin.lat_deg, origin.lon_deg, origin.height_m); }
+};
+
+// Reads the boundary sections of `root` (not finish()ed here). Throws
+// rig::ConfigError naming file, line and key.
+BoundaryCaseSpec read_boundary_case(const YamlSection& root);
+// Cross checks once every value is read: builds the route, the sprayer, the
+// devices and the area as the run will, so that a value their own checks refuse
+// is an error at load time, at its section.
+void check_boundary_case(const BoundaryCaseSpec& spec, const YamlSection& root);
+// The controller's `areas` the rig hands it when its section gives none: the
+// case's area, as the operator records its corners with the receiver before
+// work (Sec. 4.2.2). Returns the section with `areas` added.
+RawYaml controller_section_with_area(const RawYaml& controller, const BoundaryCaseSpec& spec);
+
+}  // namespace rig::harness

@@ -1,0 +1,276 @@
+#include "harness/boundary_judge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "emulators/field2d/polygon.h"
+#include "idl/topics.h"
+
+namespace rig::harness {
+namespace {
+
+BoundaryEdge nearest_edge(const field2d::Polygon& area, field2d::Vec2 near) {
+    const std::vector<field2d::Vec2>& v = area.vertices();
+    std::size_t best = 0;
+    double best_d = INFINITY;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const field2d::Vec2 a = v[i];
+        const field2d::Vec2 b = v[(i + 1) % v.size()];
+        const double d = std::hypot(near.east_m - 0.5 * (a.east_m + b.east_m), near.north_m - 0.5 * (a.north_m + b.north_m));
+        if (d < best_d) {
+            best_d = d;
+            best = i;
+        }
+    }
+    const field2d::Vec2 a = v[best];
+    const field2d::Vec2 b = v[(best + 1) % v.size()];
+    return BoundaryEdge{a.east_m, a.north_m, b.east_m, b.north_m};
+}
+
+// at("key"): the value, or an error naming the key path.
+const nlohmann::json& at(const nlohmann::json& node, const char* key, const std::string& path) {
+    if (!node.is_object() || !node.contains(key)) throw std::runtime_error("boundary judging plan: no key " + path + key);
+    return node.at(key);
+}
+
+DoseRaster raster_of(const field2d::DepositionGrid2d& grid, int nozzle) {
+    DoseRaster r;
+    r.east0_m = grid.origin().east_m;
+    r.north0_m = grid.origin().north_m;
+    r.cell_m = grid.cell_m();
+    r.nx = grid.nx();
+    r.ny = grid.ny();
+    r.dose_ul_cm2 = grid.dose_layer_ul_cm2(nozzle);
+    return r;
+}
+
+}  // namespace
+
+BoundaryJudgingPlan plan_boundary_judging(const BoundaryCaseSpec& spec) {
+    BoundaryJudgingPlan plan;
+    plan.ground = spec.ground;
+    plan.fan_angle_deg = spec.spray.fan_angle_deg;
+    plan.band_thickness_m = spec.spray.band_thickness_m;
+    const field2d::Polygon area = field2d::Polygon::from_geodetic(spec.frame(), spec.corners, spec.area_name);
+    for (const BoundaryEdgeJudging& edge : spec.edges) {
+        plan.edges.push_back(BoundaryEdgePlan{edge.metric, nearest_edge(area, edge.near), edge.probe});
+    }
+    plan.flow_per_duty = spec.judge_flow_per_duty;
+    plan.flow_settle_s = spec.flow_settle_s;
+    plan.pwm_period_s = 1.0 / spec.valves.frequency_hz;
+    const field2d::NozzleFlowTable table = spec.flow_table_or_paper();
+    for (int n = 0; n < table.nozzle_count(); ++n) plan.flow_table.push_back(table.points(n));
+    return plan;
+}
+
+nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
+    nlohmann::json edges = nlohmann::json::array();
+    for (const BoundaryEdgePlan& e : plan.edges) {
+        edges.push_back({{"metric", e.metric},
+                         {"edge", {e.edge.from_east_m, e.edge.from_north_m, e.edge.to_east_m, e.edge.to_north_m}},
+                         {"from_m", e.probe.from_m},
+                         {"to_m", e.probe.to_m},
+                         {"spacing_m", e.probe.spacing_m},
+                         {"search_inside_m", e.probe.search_inside_m},
+                         {"search_outside_m", e.probe.search_outside_m},
+                         {"wet_threshold_ul_cm2", e.probe.wet_threshold_ul_cm2}});
+    }
+    nlohmann::json table = nlohmann::json::array();
+    for (const auto& nozzle : plan.flow_table) {
+        nlohmann::json points = nlohmann::json::array();
+        for (const field2d::FlowPoint& p : nozzle) points.push_back({p.duty_pct, p.flow_ml_min});
+        table.push_back(std::move(points));
+    }
+    return {{"ground",
+             {{"east_min_m", plan.ground.east_min_m},
+              {"east_max_m", plan.ground.east_max_m},
+              {"north_min_m", plan.ground.north_min_m},
+              {"north_max_m", plan.ground.north_max_m},
+              {"cell_m", plan.ground.cell_m},
+              {"nozzle_count", plan.ground.nozzle_count}}},
+            {"fan_angle_deg", plan.fan_angle_deg},
+            {"band_thickness_m", plan.band_thickness_m},
+            {"edges", std::move(edges)},
+            {"flow_per_duty", plan.flow_per_duty},
+            {"flow_settle_s", plan.flow_settle_s},
+            {"pwm_period_s", plan.pwm_period_s},
+            {"flow_table_ml_min", std::move(table)}};
+}
+
+BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) {
+    try {
+        BoundaryJudgingPlan plan;
+        const nlohmann::json& ground = at(json, "ground", "");
+        plan.ground.east_min_m = at(ground, "east_min_m", "ground.").get<double>();
+        plan.ground.east_max_m = at(ground, "east_max_m", "ground.").get<double>();
+        plan.ground.north_min_m = at(ground, "north_min_m", "ground.").get<double>();
+        plan.ground.north_max_m = at(ground, "north_max_m", "ground.").get<double>();
+        plan.ground.cell_m = at(ground, "cell_m", "ground.").get<double>();
+        plan.ground.nozzle_count = at(ground, "nozzle_count", "ground.").get<int>();
+        plan.fan_angle_deg = at(json, "fan_angle_deg", "").get<double>();
+        plan.band_thickness_m = at(json, "band_thickness_m", "").get<double>();
+        for (const nlohmann::json& e : at(json, "edges", "")) {
+            BoundaryEdgePlan edge;
+            edge.metric = at(e, "metric", "edges[].").get<std::string>();
+            const std::vector<double> xy = at(e, "edge", "edges[].").get<std::vector<double>>();
+            if (xy.size() != 4) throw std::runtime_error("boundary judging plan: edges[].edge needs 4 numbers");
+            edge.edge = BoundaryEdge{xy[0], xy[1], xy[2], xy[3]};
+            edge.probe.from_m = at(e, "from_m", "edges[].").get<double>();
+            edge.probe.to_m = at(e, "to_m", "edges[].").get<double>();
+            edge.probe.spacing_m = at(e, "spacing_m", "edges[].").get<double>();
+            edge.probe.search_inside_m = at(e, "search_inside_m", "edges[].").get<double>();
+            edge.probe.search_outside_m = at(e, "search_outside_m", "edges[].").get<double>();
+            edge.probe.wet_threshold_ul_cm2 = at(e, "wet_threshold_ul_cm2", "edges[].").get<double>();
+            plan.edges.push_back(std::move(edge));
+        }
+        plan.flow_per_duty = at(json, "flow_per_duty", "").get<bool>();
+        plan.flow_settle_s = at(json, "flow_settle_s", "").get<double>();
+        plan.pwm_period_s = at(json, "pwm_period_s", "").get<double>();
+        for (const nlohmann::json& nozzle : at(json, "flow_table_ml_min", "")) {
+            std::vector<field2d::FlowPoint> points;
+            for (const nlohmann::json& p : nozzle) points.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+            plan.flow_table.push_back(std::move(points));
+        }
+        return plan;
+    } catch (const nlohmann::json::exception& error) {
+        throw std::runtime_error(std::string("boundary judging plan: ") + error.what());
+    }
+}
+
+std::vector<NozzleStepTruth> nozzle_step_truth(const RecordedTrace& trace) {
+    // The plant publishes a vehicle2d and a nozzles sample for each instant it reports.
+    std::map<TimeNs, std::pair<double, double>> vehicle;  // t -> heading, boom height
+    if (const auto it = trace.samples.find(topics::kVehicle2dTruth); it != trace.samples.end()) {
+        for (const RecordedSample& s : it->second) {
+            vehicle[s.json.at("time_ns").get<TimeNs>()] = {s.json.at("heading_deg").get<double>(),
+                                                           s.json.at("boom_height_m").get<double>()};
+        }
+    }
+    std::vector<NozzleStepTruth> steps;
+    const auto it = trace.samples.find(topics::kNozzlesTruth);
+    if (it == trace.samples.end()) return steps;
+    for (const RecordedSample& s : it->second) {
+        NozzleStepTruth step;
+        step.t_ns = s.json.at("time_ns").get<TimeNs>();
+        const auto v = vehicle.find(step.t_ns);
+        if (v == vehicle.end()) {
+            throw std::runtime_error("truth/nozzles at t_ns " + std::to_string(step.t_ns) +
+                                     " has no truth/vehicle2d sample of the same instant");
+        }
+        step.heading_deg = v->second.first;
+        step.boom_height_m = v->second.second;
+        for (const nlohmann::json& n : s.json.at("nozzles")) {
+            step.position.push_back(field2d::Vec2{n.at("east_m").get<double>(), n.at("north_m").get<double>()});
+            step.duty_pct.push_back(n.at("duty_pct").get<double>());
+            step.delivered_l.push_back(n.at("delivered_l").get<double>());
+        }
+        steps.push_back(std::move(step));
+    }
+    std::stable_sort(steps.begin(), steps.end(), [](const NozzleStepTruth& a, const NozzleStepTruth& b) { return a.t_ns < b.t_ns; });
+    return steps;
+}
+
+std::vector<DoseRaster> ground_from_truth(const std::vector<NozzleStepTruth>& steps, const BoundaryJudgingPlan& plan) {
+    field2d::DepositionGrid2d grid(plan.ground);
+    std::vector<double> previous(static_cast<std::size_t>(plan.ground.nozzle_count), 0.0);
+    for (const NozzleStepTruth& step : steps) {
+        if (step.delivered_l.size() != previous.size()) {
+            throw std::runtime_error("truth/nozzles at t_ns " + std::to_string(step.t_ns) + " has " +
+                                     std::to_string(step.delivered_l.size()) + " nozzles, the plan " +
+                                     std::to_string(previous.size()));
+        }
+        const double width_m = field2d::fan_width_m(step.boom_height_m, plan.fan_angle_deg);
+        for (std::size_t n = 0; n < previous.size(); ++n) {
+            const double litres = step.delivered_l[n] - previous[n];
+            previous[n] = step.delivered_l[n];
+            if (litres > 0.0) {
+                grid.deposit_band(static_cast<int>(n), step.position[n], step.heading_deg, width_m,
+                                  plan.band_thickness_m, litres);
+            }
+        }
+    }
+    std::vector<DoseRaster> layers;
+    for (int n = 0; n < plan.ground.nozzle_count; ++n) layers.push_back(raster_of(grid, n));
+    return layers;
+}
+
+std::vector<FlowRecord> flow_records_from_truth(const std::vector<NozzleStepTruth>& steps, const BoundaryJudgingPlan& plan) {
+    std::vector<FlowRecord> records;
+    const TimeNs settle = seconds_to_ns(plan.flow_settle_s);
+    const double period_s = plan.pwm_period_s;
+    const std::size_t nozzles = steps.empty() ? 0 : steps.front().duty_pct.size();
+    for (std::size_t n = 0; n < nozzles; ++n) {
+        // Runs of samples at one (non-zero) duty.
+        std::size_t begin = 0;
+        while (begin < steps.size()) {
+            const double duty = steps[begin].duty_pct[n];
+            std::size_t end = begin;
+            while (end < steps.size() && steps[end].duty_pct[n] == duty) ++end;
+            if (duty > 0.0) {
+                std::size_t a = begin;
+                while (a < end && steps[a].t_ns < steps[begin].t_ns + settle) ++a;
+                // The end sample that makes the window closest to a whole number of PWM periods.
+                std::size_t best = end;
+                double best_miss = INFINITY;
+                for (std::size_t b = end; b-- > a + 1;) {
+                    const double span_s = ns_to_seconds(steps[b].t_ns - steps[a].t_ns);
+                    if (span_s < period_s) break;
+                    if (ns_to_seconds(steps[end - 1].t_ns - steps[b].t_ns) > period_s) break;
+                    const double miss = std::abs(span_s / period_s - std::round(span_s / period_s));
+                    if (miss < best_miss) {
+                        best_miss = miss;
+                        best = b;
+                    }
+                }
+                if (best < end) {
+                    records.push_back(FlowRecord{static_cast<int>(n), duty,
+                                                 steps[best].delivered_l[n] - steps[a].delivered_l[n],
+                                                 ns_to_seconds(steps[best].t_ns - steps[a].t_ns)});
+                }
+            }
+            begin = end;
+        }
+    }
+    return records;
+}
+
+MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgingPlan& plan) {
+    MetricSet metrics;
+    const std::vector<NozzleStepTruth> steps = nozzle_step_truth(trace);
+    if (!plan.edges.empty()) {
+        const std::vector<DoseRaster> layers = ground_from_truth(steps, plan);
+        const DoseRaster total = sum_rasters(layers);
+        for (const BoundaryEdgePlan& e : plan.edges) {
+            const EdgeProfile profile = wet_edge_profile(total, e.edge, e.probe);
+            for (const auto& [name, value] : excess_metrics(e.metric, profile)) metrics.values[name] = value;
+            if (profile.excess_m.empty() || std::all_of(profile.excess_m.begin(), profile.excess_m.end(),
+                                                        [](double x) { return std::isnan(x); })) {
+                metrics.not_measured[e.metric + "_mean_m"] = "no wet ground at any station of the edge";
+                metrics.not_measured[e.metric + "_sd_m"] = "no wet ground at any station of the edge";
+            }
+            std::vector<EdgeProfile> per_nozzle;
+            for (const DoseRaster& layer : layers) per_nozzle.push_back(wet_edge_profile(layer, e.edge, e.probe));
+            for (const auto& [name, value] : per_nozzle_excess_metrics(e.metric, per_nozzle)) metrics.values[name] = value;
+        }
+    }
+    if (plan.flow_per_duty) {
+        const field2d::NozzleFlowTable table(plan.flow_table);
+        const std::vector<FlowCheckRow> rows = flow_against_table(flow_records_from_truth(steps, plan), table);
+        for (const FlowCheckRow& row : rows) {
+            const std::string key = "flow_nozzle" + std::to_string(row.nozzle) + "_duty" +
+                                    std::to_string(static_cast<int>(std::lround(row.duty_pct)));
+            metrics.values[key + "_l_min"] = row.delivered_ml_min / 1000.0;
+        }
+        for (const auto& [name, value] : flow_table_metrics(rows)) metrics.values[name] = value;
+        if (rows.size() >= 2) {
+            for (const auto& [name, value] : eq13_fit_metrics(rows)) metrics.values[name] = value;
+        } else {
+            metrics.not_measured["flow_table_max_abs_error_pct"] = "fewer than two duties held";
+        }
+    }
+    return metrics;
+}
+
+}  // namespace rig::harness

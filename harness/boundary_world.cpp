@@ -1,0 +1,155 @@
+#include "harness/boundary_world.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "idl/topics.h"
+
+namespace rig::harness {
+
+BoundaryWorld::BoundaryWorld(const BoundaryCaseSpec& spec, std::uint64_t seed)
+    : kinematics(spec.frame(), field2d::Route2d(spec.route_start, spec.route_segments), spec.mounting,
+                 field2d::BoomHeightProfile(spec.boom_height)),
+      valves(spec.valves),
+      ad300(spec.ad300),
+      laser(spec.laser) {
+    // One seed, three devices: each draws from its own named streams
+    // (emulators/seeded_random.h), so they do not share a sequence.
+    valves.seed = seed;
+    ad300.seed = seed;
+    laser.seed = seed;
+    end_ns = seconds_to_ns(kinematics.route().end_time_s() + spec.end_after_route_s);
+}
+
+// ---------------------------------------------------------------- plant
+
+BoundaryPlantNode::BoundaryPlantNode(const field2d::SprayerKinematics& kinematics, emulators::PwmNozzleValves valves,
+                                     emulators::SprayDepositionParams spray, double idle_truth_rate_hz)
+    : kinematics_(kinematics),
+      valves_(std::move(valves)),
+      spray_(spray),
+      step_ns_(seconds_to_ns(spray.step_s)),
+      idle_period_ns_(seconds_to_ns(1.0 / idle_truth_rate_hz)),
+      commanded_pct_(static_cast<std::size_t>(valves_.nozzle_count()), 0.0) {}
+
+void BoundaryPlantNode::configure(DdsContext& dds) {
+    duty_reader_ = std::make_unique<Reader<msg::NozzlePwm>>(dds, topics::kNozzlePwm);
+    vehicle_writer_ = std::make_unique<Writer<msg::Vehicle2dTruth>>(dds, topics::kVehicle2dTruth);
+    nozzles_writer_ = std::make_unique<Writer<msg::NozzlesTruth>>(dds, topics::kNozzlesTruth);
+}
+
+bool BoundaryPlantNode::may_flow() const {
+    for (int n = 0; n < valves_.nozzle_count(); ++n) {
+        if (commanded_pct_[static_cast<std::size_t>(n)] > 0.0 || valves_.opening(n) > 0.0 ||
+            valves_.active_duty_pct(n) > 0.0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void BoundaryPlantNode::publish_truth(TimeNs mid_ns) {
+    const field2d::SprayerTruth truth = kinematics_.truth_at(ns_to_seconds(mid_ns));
+    msg::Vehicle2dTruth vehicle;
+    vehicle.time_ns(mid_ns);
+    vehicle.east_m(truth.pose.position.east_m);
+    vehicle.north_m(truth.pose.position.north_m);
+    vehicle.heading_deg(truth.pose.heading_deg);
+    vehicle.speed_m_s(truth.pose.speed_m_s);
+    vehicle.yaw_rate_deg_s(truth.pose.yaw_rate_deg_s);
+    vehicle.antenna_east_m(truth.antenna.east_m);
+    vehicle.antenna_north_m(truth.antenna.north_m);
+    vehicle.antenna_lat_deg(truth.antenna_geodetic.lat_deg);
+    vehicle.antenna_lon_deg(truth.antenna_geodetic.lon_deg);
+    vehicle.antenna_height_m(truth.antenna_geodetic.height_m);
+    vehicle.antenna_velocity_east_m_s(truth.antenna_velocity_m_s.east_m);
+    vehicle.antenna_velocity_north_m_s(truth.antenna_velocity_m_s.north_m);
+    vehicle.boom_height_m(truth.boom_height_m);
+    vehicle.boom_offset_m(truth.boom_offset_m);
+    vehicle.boom_centre_east_m(truth.boom_centre.east_m);
+    vehicle.boom_centre_north_m(truth.boom_centre.north_m);
+    vehicle_writer_->publish(vehicle);
+
+    msg::NozzlesTruth nozzles;
+    nozzles.time_ns(mid_ns);
+    for (int n = 0; n < valves_.nozzle_count(); ++n) {
+        msg::NozzleTruth nozzle;
+        nozzle.east_m(truth.nozzles[static_cast<std::size_t>(n)].east_m);
+        nozzle.north_m(truth.nozzles[static_cast<std::size_t>(n)].north_m);
+        nozzle.duty_pct(valves_.active_duty_pct(n));
+        nozzle.opening(valves_.opening(n));
+        nozzle.flow_l_min(valves_.flow_ml_min(n) / 1000.0);
+        nozzle.delivered_l(valves_.delivered_l(n));
+        nozzles.nozzles().push_back(nozzle);
+    }
+    nozzles_writer_->publish(nozzles);
+}
+
+TimeNs BoundaryPlantNode::step(TimeNs now_ns) {
+    // Whole steps up to now first: a duty that arrives at now acts from now on.
+    while (valves_.now_ns() + step_ns_ <= now_ns) {
+        const TimeNs from = valves_.now_ns();
+        const std::vector<double> litres = valves_.advance(from + step_ns_);
+        const bool delivered = std::any_of(litres.begin(), litres.end(), [](double l) { return l > 0.0; });
+        const TimeNs mid = from + step_ns_ / 2;
+        if (delivered || mid >= next_idle_truth_ns_) {
+            publish_truth(mid);
+            next_idle_truth_ns_ = mid + idle_period_ns_;
+        }
+    }
+    for (const msg::NozzlePwm& pwm : duty_reader_->take_all()) {
+        const std::vector<double>& duty = pwm.duty_pct();
+        if (duty.size() > commanded_pct_.size()) ++rejected_commands_;
+        for (std::size_t n = 0; n < std::min(duty.size(), commanded_pct_.size()); ++n) {
+            double value = duty[n];
+            if (!std::isfinite(value) || value < 0.0 || value > 100.0) {
+                // A driver stage cannot do more than always on or always off.
+                ++rejected_commands_;
+                value = std::isfinite(value) ? std::clamp(value, 0.0, 100.0) : 0.0;
+            }
+            if (value != commanded_pct_[n]) {
+                valves_.command(static_cast<int>(n), value, now_ns);
+                commanded_pct_[n] = value;
+            }
+        }
+    }
+    const TimeNs next_step = valves_.now_ns() + step_ns_;
+    if (may_flow()) return next_step;
+    // Idle: wake at the end of the first step whose middle is due for truth.
+    const TimeNs first_due_step = std::max<TimeNs>(0, (next_idle_truth_ns_ - step_ns_ / 2 + step_ns_ - 1) / step_ns_);
+    return std::max(next_step, (first_due_step + 1) * step_ns_);
+}
+
+// ---------------------------------------------------------------- serial devices
+
+Ad300Node::Ad300Node(const field2d::SprayerKinematics& kinematics, emulators::Ad300Params params)
+    : receiver_(kinematics, std::move(params)) {}
+
+void Ad300Node::configure(DdsContext& dds) { writer_ = std::make_unique<Writer<msg::NmeaSentence>>(dds, topics::kGnssNmea); }
+
+TimeNs Ad300Node::step(TimeNs now_ns) {
+    for (const emulators::TimedLine& line : receiver_.poll(now_ns)) {
+        msg::NmeaSentence sample;
+        sample.sentence(line.text);
+        writer_->publish(sample);
+    }
+    return receiver_.next_due_ns();
+}
+
+L4LaserNode::L4LaserNode(const field2d::SprayerKinematics& kinematics, emulators::L4LaserParams params)
+    : sensor_(kinematics, std::move(params)) {}
+
+void L4LaserNode::configure(DdsContext& dds) {
+    writer_ = std::make_unique<Writer<msg::SerialLine>>(dds, topics::kLaserHeightSerial);
+}
+
+TimeNs L4LaserNode::step(TimeNs now_ns) {
+    for (const emulators::TimedLine& line : sensor_.poll(now_ns)) {
+        msg::SerialLine sample;
+        sample.text(line.text);
+        writer_->publish(sample);
+    }
+    return sensor_.next_due_ns();
+}
+
+}  // namespace rig::harness

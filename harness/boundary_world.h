@@ -1,0 +1,103 @@
+#pragma once
+// Seed 001's world for one run of a boundary case (harness/boundary_case.h):
+// the sprayer's 2-D kinematics, and the rig's local nodes that the lockstep
+// master steps each instant, in this order:
+//   BoundaryPlantNode  takes the controller's PWM duties (actuator/nozzle_pwm/duty),
+//                      runs the six valves on the deposition step grid and
+//                      publishes the truth the judge rebuilds the ground from
+//                      (truth/vehicle2d, truth/nozzles);
+//   Ad300Node          the AD300's RMC lines on device/gnss/nmea;
+//   L4LaserNode        the L4 laser's lines on device/laser_height/serial.
+// A pure function of the case and the seed: same seed, same trace.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emulators/ad300_receiver.h"
+#include "emulators/boundary_spray_plant.h"
+#include "emulators/field2d/sprayer_kinematics.h"
+#include "emulators/l4_laser_sensor.h"
+#include "emulators/pwm_nozzle_valves.h"
+#include "harness/boundary_case.h"
+#include "rig/runtime/dds_context.h"
+#include "rig/runtime/node.h"
+
+namespace rig::harness {
+
+struct BoundaryWorld {
+    BoundaryWorld(const BoundaryCaseSpec& spec, std::uint64_t seed);
+    field2d::SprayerKinematics kinematics;
+    emulators::PwmValveParams valves;
+    emulators::Ad300Params ad300;
+    emulators::L4LaserParams laser;
+    TimeNs end_ns = 0;
+};
+
+// The plant's side of the nozzles. Truth, per deposition step (spray.step_s,
+// on a fixed grid from t = 0, as emulators/boundary_spray_plant.h integrates):
+// a NozzlesTruth and a Vehicle2dTruth stamped at the step's middle (where the
+// plant lays that step's volume), with each nozzle's delivered volume at the
+// step's end, for every step in which any nozzle delivered; while nothing
+// flows, one pair every 1 / idle_truth_rate_hz. The judge lays each step's
+// volume (the difference of delivered_l) as the fan band there, which is
+// exactly what the plant does: the ground is rebuilt from the trace alone.
+class BoundaryPlantNode final : public Node {
+public:
+    BoundaryPlantNode(const field2d::SprayerKinematics& kinematics, emulators::PwmNozzleValves valves,
+                      emulators::SprayDepositionParams spray, double idle_truth_rate_hz);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override { return duty_reader_->has_unread(); }
+    // Duty commands the plant could not take (outside [0, 100] %, not finite,
+    // more nozzles than the boom has): clamped or dropped, counted here.
+    std::uint64_t rejected_commands() const { return rejected_commands_; }
+
+private:
+    void publish_truth(TimeNs mid_ns);
+    bool may_flow() const;
+
+    std::string name_ = "boundary_plant";
+    const field2d::SprayerKinematics& kinematics_;
+    emulators::PwmNozzleValves valves_;
+    emulators::SprayDepositionParams spray_;
+    TimeNs step_ns_ = 0;
+    TimeNs idle_period_ns_ = 0;
+    TimeNs next_idle_truth_ns_ = 0;
+    std::vector<double> commanded_pct_;
+    std::uint64_t rejected_commands_ = 0;
+    std::unique_ptr<Reader<msg::NozzlePwm>> duty_reader_;
+    std::unique_ptr<Writer<msg::Vehicle2dTruth>> vehicle_writer_;
+    std::unique_ptr<Writer<msg::NozzlesTruth>> nozzles_writer_;
+};
+
+// A serial device's lines as samples on its device topic, each at the instant
+// its last byte is on the wire.
+class Ad300Node final : public Node {
+public:
+    Ad300Node(const field2d::SprayerKinematics& kinematics, emulators::Ad300Params params);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+
+private:
+    std::string name_ = "ad300";
+    emulators::Ad300Receiver receiver_;
+    std::unique_ptr<Writer<msg::NmeaSentence>> writer_;
+};
+
+class L4LaserNode final : public Node {
+public:
+    L4LaserNode(const field2d::SprayerKinematics& kinematics, emulators::L4LaserParams params);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+
+private:
+    std::string name_ = "l4_laser";
+    emulators::L4LaserSensor sensor_;
+    std::unique_ptr<Writer<msg::SerialLine>> writer_;
+};
+
+}  // namespace rig::harness

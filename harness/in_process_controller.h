@@ -1,0 +1,63 @@
+#pragma once
+// Software-in-the-loop: the controller as a plugin, stepped inside the
+// harness's process (rig/runtime/node_plugin.h). Process mode stays the
+// default and the only mode for outside programs without a plugin, for
+// real-time cases and for the bench.
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "harness/case_spec.h"
+#include "rig/host/node_plugin_loader.h"
+#include "rig/runtime/dds_context.h"
+
+namespace rig::harness {
+
+struct RunOptions;
+
+// Where a case's controller runs, decided before anything starts.
+struct ControllerPlacement {
+    std::optional<std::filesystem::path> plugin;  // set: run this plugin in process
+    std::string refused;  // asked for in process but cannot be (why), reported in results.json
+};
+// The case's `controller.in_process`, else `rig run --in-process`; a case that
+// cannot run in process (real time, a program without a plugin) runs as a
+// process, with the reason.
+ControllerPlacement place_controller(const CaseSpec& spec, const RunOptions& options);
+
+// The plugin a case names (relative to the case file), or the reference
+// controller's (options.controller_plugin); empty when the case's controller
+// is a program without one.
+std::filesystem::path controller_plugin_of(const CaseSpec& spec, const RunOptions& options);
+
+// dlopen'ed once per file for the whole run (plugins are never unloaded).
+std::shared_ptr<NodePluginLibrary> load_controller_plugin(const std::filesystem::path& file);
+
+// One run's in-process controller: its node, on a DDS participant of its own,
+// registered with the harness's as a guest (its endpoints and samples are
+// judged like a process's), its log in the case directory.
+class InProcessController {
+public:
+    // Throws std::runtime_error when the plugin fails to make the node; a
+    // refusal (this configuration must run as a process) is returned by make().
+    static std::unique_ptr<InProcessController> make(const std::shared_ptr<NodePluginLibrary>& library,
+                                                     const std::filesystem::path& config_file,
+                                                     const std::filesystem::path& state_dir,
+                                                     const std::filesystem::path& log_file, DdsContext& harness_dds,
+                                                     std::string& refusal);
+    ~InProcessController();
+    Node& node() { return *node_; }
+    DdsContext& dds() { return *dds_; }
+    const std::filesystem::path& plugin_file() const { return library_->file(); }
+
+private:
+    InProcessController() = default;
+    std::shared_ptr<NodePluginLibrary> library_;
+    std::ofstream log_;
+    std::unique_ptr<DdsContext> dds_;
+    std::unique_ptr<Node> node_;  // destroyed before its DDS context
+};
+
+}  // namespace rig::harness

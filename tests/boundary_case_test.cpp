@@ -1,0 +1,171 @@
+// Seed 001's boundary cases without DDS: the loader (harness/boundary_case.h
+// through the case loader), the judging plan's round trip through the trace's
+// JSON, and the judge's rebuilding of the ground and of flow per duty from
+// truth samples with a known answer (harness/boundary_judge.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "harness/boundary_case.h"
+#include "harness/boundary_judge.h"
+#include "harness/case_spec.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace rig::harness;
+
+std::string shipped(const std::string& relative) {
+    std::ifstream in(fs::path(RIG_SOURCE_DIR) / "cases" / relative);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// The shipped drive-out case with one line replaced (the test fails if the line is gone).
+std::string edited(const std::string& from, const std::string& to) {
+    std::string text = shipped("seed001-table8-boundary/drive-out.yaml");
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+}
+
+std::string load_error(const std::string& text) {
+    try {
+        parse_case(text, "case.yaml");
+    } catch (const rig::ConfigError& error) {
+        return error.what();
+    }
+    return "(accepted)";
+}
+
+TEST(BoundaryCase, TheShippedDriveOutCaseReadsAsWritten) {
+    const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
+    ASSERT_EQ(spec.system, CaseSystem::boundary);
+    ASSERT_TRUE(spec.boundary);
+    const BoundaryCaseSpec& b = *spec.boundary;
+    EXPECT_EQ(b.corners.size(), 4u);
+    EXPECT_DOUBLE_EQ(b.route_start.position.north_m, -12.0);
+    EXPECT_EQ(b.route_segments.size(), 2u);
+    ASSERT_EQ(b.edges.size(), 1u);
+    EXPECT_EQ(b.edges[0].metric, "drive_out_excess");
+    EXPECT_EQ(spec.seeds, (std::vector<std::uint64_t>{1, 2, 3}));
+    // No seed-000 default limit is added to a boundary case.
+    EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"drive_out_excess_mean_m", 0.50}}));
+    // The controller is told the area (its corners as recorded) unless its section gives its own.
+    ASSERT_TRUE(spec.controller.params.node["areas"]);
+    EXPECT_EQ(spec.controller.params.node["areas"][0]["corners"].size(), 4u);
+    EXPECT_DOUBLE_EQ(spec.controller.params.node["areas"][0]["density"].as<double>(), 0.5);
+}
+
+TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
+    // A misspelt key, with the known one suggested.
+    EXPECT_NE(load_error(edited("judge:\n", "ad300: { latency: 0.05 }\njudge:\n")).find("ad300.latency"), std::string::npos);
+    // A value an emulator refuses is reported at its section, naming the parameter.
+    const std::string rate = load_error(edited("judge:\n", "ad300: { rate_hz: 0 }\njudge:\n"));
+    EXPECT_NE(rate.find("case.yaml:"), std::string::npos) << rate;
+    EXPECT_NE(rate.find("ad300"), std::string::npos) << rate;
+    EXPECT_NE(rate.find("rate_hz"), std::string::npos) << rate;
+    // An unknown edge metric.
+    const std::string metric = load_error(edited("metric: drive_out_excess", "metric: drive_out"));
+    EXPECT_NE(metric.find("judge.edges[0].metric"), std::string::npos) << metric;
+    // An expected failure with no limit in the file.
+    const std::string expect = load_error(edited("limits:\n", "expect: { fail: [drive_in_excess_mean_m] }\nlimits:\n"));
+    EXPECT_NE(expect.find("expect.fail[0]"), std::string::npos) << expect;
+    // A case that judges nothing.
+    EXPECT_NE(load_error(edited("  edges:\n", "  unused_edges:\n")).find("judge"), std::string::npos);
+    // A corner recorded twice is no polygon: refused at `area`, naming it.
+    const std::string area = load_error(edited("    - { lat_deg: 35.1000000000, lon_deg: 113.2998903247 }",
+                                               "    - { lat_deg: 35.1000000000, lon_deg: 113.3001096753 }"));
+    EXPECT_NE(area.find(": area: "), std::string::npos) << area;
+    EXPECT_NE(area.find("plot"), std::string::npos) << area;
+    // A system the rig does not know.
+    EXPECT_NE(load_error(edited("system: boundary", "system: boundry")).find("did you mean 'boundary'"), std::string::npos);
+}
+
+TEST(BoundaryJudge, ThePlanSurvivesTheTracesJson) {
+    const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
+    const BoundaryJudgingPlan plan = plan_boundary_judging(*spec.boundary);
+    // The north edge (north = 0), the area on its left: from east +10 to -10.
+    ASSERT_EQ(plan.edges.size(), 1u);
+    EXPECT_NEAR(plan.edges[0].edge.from_east_m, 10.0, 1e-3);
+    EXPECT_NEAR(plan.edges[0].edge.to_east_m, -10.0, 1e-3);
+    EXPECT_NEAR(plan.edges[0].edge.from_north_m, 0.0, 1e-3);
+    const BoundaryJudgingPlan back = boundary_judging_plan_from_json(nlohmann::json::parse(to_json(plan).dump()));
+    EXPECT_EQ(to_json(back), to_json(plan));
+    EXPECT_EQ(back.flow_table.size(), 6u);
+    EXPECT_THROW(boundary_judging_plan_from_json(nlohmann::json::object()), std::runtime_error);
+}
+
+BoundaryJudgingPlan small_plan() {
+    BoundaryJudgingPlan plan;
+    plan.ground.east_min_m = -2;
+    plan.ground.east_max_m = 2;
+    plan.ground.north_min_m = -2;
+    plan.ground.north_max_m = 2;
+    plan.ground.cell_m = 0.02;
+    plan.ground.nozzle_count = 1;
+    return plan;
+}
+
+NozzleStepTruth step_at(double t_s, double north_m, double delivered_l, double duty_pct = 100.0) {
+    NozzleStepTruth step;
+    step.t_ns = rig::seconds_to_ns(t_s);
+    step.heading_deg = 0.0;
+    step.boom_height_m = 0.5;
+    step.position = {{0.0, north_m}};
+    step.duty_pct = {duty_pct};
+    step.delivered_l = {delivered_l};
+    return step;
+}
+
+TEST(BoundaryJudge, TheGroundIsEachStepsVolumeLaidAsTheFanBand) {
+    // One nozzle driving north at 1 m/s, 1 mL per 5 ms step, from north -1 to +1.
+    std::vector<NozzleStepTruth> steps;
+    for (int k = 0; k <= 400; ++k) steps.push_back(step_at(k * 0.005, -1.0 + k * 0.005, 0.001 * k));
+    const std::vector<DoseRaster> layers = ground_from_truth(steps, small_plan());
+    ASSERT_EQ(layers.size(), 1u);
+    double litres = 0.0;
+    for (double dose : layers[0].dose_ul_cm2) litres += dose * 2.0 * 2.0 * 1e-6;  // uL/cm^2 x 4 cm^2 -> L
+    EXPECT_NEAR(litres, 0.400, 1e-9);  // the first sample is the reference, the 400 after it deliver
+    // Across the track the fan reaches H tan 55 deg = 0.714 m: an edge along
+    // east = 0.5 (outside to the east) sees the wet edge 0.214 m past it.
+    const BoundaryEdge edge{0.5, -1.5, 0.5, 1.5};
+    EdgeProbe probe;
+    probe.from_m = 1.0;
+    probe.to_m = 2.0;
+    const auto m = excess_metrics("boundary_overrun", wet_edge_profile(layers[0], edge, probe));
+    EXPECT_NEAR(m.at("boundary_overrun_mean_m"), 0.714 - 0.5, 0.02);
+}
+
+TEST(BoundaryJudge, FlowPerDutyIsTheVolumeOverWholePwmPeriods) {
+    BoundaryJudgingPlan plan = small_plan();
+    plan.flow_settle_s = 0.5;
+    // 0.6 L/min at 100 % for 5 s, then 0.3 L/min at 40 % for 5 s, sampled every 5 ms.
+    std::vector<NozzleStepTruth> steps;
+    double delivered = 0.0;
+    for (int k = 0; k < 2000; ++k) {
+        const bool first = k < 1000;
+        delivered += (first ? 0.6 : 0.3) / 60.0 * 0.005;
+        steps.push_back(step_at(k * 0.005, 0.0, delivered, first ? 100.0 : 40.0));
+    }
+    const std::vector<FlowRecord> records = flow_records_from_truth(steps, plan);
+    ASSERT_EQ(records.size(), 2u);
+    EXPECT_EQ(records[0].duty_pct, 100.0);
+    EXPECT_NEAR(records[0].volume_l / records[0].duration_s * 60.0, 0.6, 1e-9);
+    EXPECT_EQ(records[1].duty_pct, 40.0);
+    EXPECT_NEAR(records[1].volume_l / records[1].duration_s * 60.0, 0.3, 1e-9);
+    // A window a whole number of 1/9 s periods long, within one 5 ms step.
+    for (const FlowRecord& r : records) {
+        const double periods = r.duration_s * 9.0;
+        EXPECT_NEAR(periods, std::round(periods), 0.005 * 9.0);
+        EXPECT_GT(r.duration_s, 4.0);
+    }
+}
+
+}  // namespace

@@ -1,0 +1,138 @@
+// Seed 001's boundary cases as whole runs through `rig run` (harness + the
+// 2-D plant, AD300 and L4 nodes + rig-boundary-controller over DDS on
+// loopback) and `rig judge`: the reference controller passes, a faulty one
+// fails on exactly its named metric, the judge reproduces every metric from
+// the traces, the same seed gives the same trace, and a broken boundary case
+// file is refused before anything runs, naming the key.
+#include <gtest/gtest.h>
+
+#include "run_support.h"
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kCases = fs::path(RIG_SOURCE_DIR) / "cases";
+
+fs::path fresh_dir(const std::string& name) {
+    return rig::testing::fresh_dir("seed001-cases-" + std::to_string(::getpid()) + "-" + name);
+}
+
+int rig(const std::string& args, const fs::path& log) {
+    const std::string command =
+        "timeout -k 10 600 '" RIG_BINARY_DIR "/bin/rig' " + args + " > '" + log.string() + "' 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+nlohmann::json load_results(const fs::path& out) {
+    std::ifstream in(out / "results.json");
+    if (!in) {
+        ADD_FAILURE() << "no results.json in " << out;
+        return nlohmann::json::object();
+    }
+    return nlohmann::json::parse(in);
+}
+
+const nlohmann::json& find_case(const nlohmann::json& results, const std::string& name) {
+    for (const auto& c : results.at("cases")) {
+        if (c.at("name") == name) return c;
+    }
+    throw std::runtime_error("no case " + name + " in the results");
+}
+
+std::set<std::string> failing_metrics(const nlohmann::json& one_case) {
+    std::set<std::string> metrics;
+    for (const auto& failure : one_case.at("failures")) {
+        const std::string line = failure.get<std::string>();
+        metrics.insert(line.substr(0, line.find(' ')));
+    }
+    return metrics;
+}
+
+TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
+    const fs::path out = fresh_dir("verdicts");
+    const std::string files = "'" + (kCases / "seed001-table8-boundary" / "drive-out.yaml").string() + "' '" +
+                              (kCases / "seed001-faulty-controllers" / "wrong-antenna-offset.yaml").string() + "' '" +
+                              (kCases / "seed001-faulty-controllers" / "no-course-rotation.yaml").string() + "'";
+    const int status = rig("run " + files + " --seed 1 --jobs 2 --out '" + (out / "run").string() + "'", out / "run.log");
+    ASSERT_EQ(status, 0) << rig::testing::read_all(out / "run.log");
+    const nlohmann::json results = load_results(out / "run");
+
+    const nlohmann::json& reference = find_case(results, "seed001-table8-drive-out-seed1");
+    EXPECT_TRUE(reference.at("passed").get<bool>()) << reference.dump(2);
+    EXPECT_TRUE(reference.at("failures").empty());
+    // Driving out, the reference controller stops the spray past the edge by
+    // the loop's delay (0.05-0.28 s at 1.5 m/s) plus half the fan band, not
+    // before the edge and not a metre after it.
+    const double excess = reference.at("metrics").at("drive_out_excess_mean_m").get<double>();
+    EXPECT_GT(excess, 0.05);
+    EXPECT_LT(excess, 0.5);
+    EXPECT_EQ(reference.at("metrics").at("drive_out_excess_stations").get<double>(), 8.0);
+
+    // The wrong antenna offset (1 m) shuts the nozzles about 1 m late: caught on drive-out.
+    const nlohmann::json& offset = find_case(results, "seed001-faulty-wrong-antenna-offset");
+    EXPECT_TRUE(offset.at("expected_failure").get<bool>()) << offset.dump(2);
+    EXPECT_EQ(failing_metrics(offset), std::set<std::string>{"drive_out_excess_mean_m"});
+    EXPECT_GT(offset.at("metrics").at("drive_out_excess_mean_m").get<double>(), excess + 0.8);
+
+    const nlohmann::json& rotation = find_case(results, "seed001-faulty-no-course-rotation");
+    EXPECT_TRUE(rotation.at("expected_failure").get<bool>()) << rotation.dump(2);
+    EXPECT_EQ(failing_metrics(rotation), std::set<std::string>{"boundary_overrun_mean_m"});
+
+    // Every metric and verdict again from the traces alone.
+    EXPECT_EQ(rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",
+                  out / "judge.log"),
+              0)
+        << rig::testing::read_all(out / "judge.log");
+}
+
+TEST(Seed001Cases, SameSeedSameTraceAnotherSeedAnotherTrace) {
+    const fs::path out = fresh_dir("digest");
+    const std::string file = "'" + (kCases / "seed001-table8-boundary" / "drive-in.yaml").string() + "'";
+    std::string digest[3];
+    const int seeds[3] = {2, 2, 3};
+    for (int i = 0; i < 3; ++i) {
+        const fs::path run = out / ("run" + std::to_string(i));
+        ASSERT_EQ(rig("run " + file + " --seed " + std::to_string(seeds[i]) + " --out '" + run.string() + "'",
+                      out / "run.log"),
+                  0)
+            << rig::testing::read_all(out / "run.log");
+        const nlohmann::json results = load_results(run);
+        digest[i] = results.at("cases").at(0).at("trace_sha256").get<std::string>();
+        ASSERT_FALSE(digest[i].empty());
+    }
+    EXPECT_EQ(digest[0], digest[1]);
+    // Another seed moves the epochs and the PWM phase: another trace.
+    EXPECT_NE(digest[0], digest[2]);
+}
+
+TEST(Seed001Cases, ABrokenBoundaryCaseIsRefusedNamingTheKey) {
+    const fs::path out = fresh_dir("broken");
+    std::string text = rig::testing::read_all(kCases / "seed001-table8-boundary" / "drive-out.yaml");
+    const std::string good = "- straight: { length_m: 16.0, speed_m_s: 1.5 }";
+    const auto at = text.find(good);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, good.size(), "- straight: { length_m: -16.0, speed_m_s: 1.5 }");
+    std::ofstream(out / "broken.yaml") << text;
+    const int status = rig("run '" + (out / "broken.yaml").string() + "' --out '" + (out / "run").string() + "'",
+                           out / "run.log");
+    const std::string log = rig::testing::read_all(out / "run.log");
+    EXPECT_NE(status, 0) << log;
+    EXPECT_NE(log.find("broken.yaml"), std::string::npos) << log;
+    EXPECT_NE(log.find("route"), std::string::npos) << log;
+    EXPECT_NE(log.find("segment 0"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(out / "run" / "cases")) << "nothing may run";
+}
+
+}  // namespace
