@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <thread>
 
 #include "rig/host/child_process.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/host/domain_lease.h"
 #include "rig/runtime/lockstep.h"
+#include "idl/topics.h"
 
 namespace {
 
@@ -120,6 +122,42 @@ TEST(Lockstep, NodeProcessThatDiesFailsByName) {
         EXPECT_EQ(failure.node_name(), "echo");
         EXPECT_NE(std::string(failure.what()).find("signal 9"), std::string::npos) << failure.what();
     }
+}
+
+// A node whose tick reader missed the hello, as a Cyclone DDS reader that
+// matched the tick writer after the hello was written does (its volatile
+// reader starts after the writer's first heartbeat): the master sends the
+// hello again until every node answered (docs/controller-contract.md,
+// "Conformance findings"). The node here drops the first copy on purpose.
+TEST(Lockstep, TheHelloIsSentAgainUntilEveryNodeAnswered) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext harness(lease.domain_id(), "harness");
+    rig::DdsContext node(lease.domain_id(), "late-reader");
+    rig::Reader<rig::msg::ClockTick> ticks(node, rig::topics::kClockTick);
+    rig::Writer<rig::msg::ClockAck> acks(node, rig::topics::kClockAck, false);
+    rig::LockstepTimeouts timeouts;
+    timeouts.startup = std::chrono::milliseconds(10'000);
+    rig::LockstepMaster master(harness, timeouts);
+    master.add_remote_node("late-reader", {});
+    int hellos_seen = 0;
+    std::thread late_reader([&] {
+        const rig::WallStopwatch waited;
+        while (waited.elapsed() < timeouts.startup) {
+            ticks.wait_for_data(std::chrono::milliseconds(50));
+            for (const rig::msg::ClockTick& tick : ticks.take_all()) {
+                if (tick.seq() != 0 || ++hellos_seen == 1) continue;
+                rig::msg::ClockAck ack;
+                ack.node_name("late-reader");
+                ack.seq(0);
+                acks.publish(ack);
+                return;
+            }
+        }
+    });
+    EXPECT_NO_THROW(master.start());
+    late_reader.join();
+    EXPECT_GE(hellos_seen, 2);
+    master.shutdown(true);  // the node is gone: do not wait for its last answer
 }
 
 }  // namespace

@@ -24,24 +24,7 @@ namespace fs = std::filesystem;
 fs::path fresh_dir(const std::string& name) { return rig::testing::fresh_dir("network-loopback-" + name); }
 
 using rig::testing::read_all;
-
-// Destinations in an strace log (sendto/sendmsg/connect lines as strace 6 prints them).
-std::set<std::string> strace_destinations(const fs::path& strace_log) {
-    std::set<std::string> found;
-    std::ifstream log(strace_log);
-    const std::regex ipv4(R"re(sin_addr=inet_addr\("([^"]+)"\))re");
-    const std::regex ipv6(R"re(inet_pton\(AF_INET6, "([^"]+)")re");
-    std::string line;
-    while (std::getline(log, line)) {
-        for (const auto* pattern : {&ipv4, &ipv6}) {
-            for (auto it = std::sregex_iterator(line.begin(), line.end(), *pattern); it != std::sregex_iterator();
-                 ++it) {
-                found.insert((*it)[1]);
-            }
-        }
-    }
-    return found;
-}
+using rig::testing::strace_destinations;
 
 // Destinations in a send_destination_recorder log: "<pid> <call> <family> <address> <port>".
 std::set<std::string> recorder_destinations(const fs::path& recorder_log) {

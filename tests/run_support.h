@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -36,6 +38,24 @@ inline std::string read_all_command(const std::string& command) {
         ::pclose(pipe);
     }
     return output;
+}
+
+// Destinations in an strace log (sendto/sendmsg/connect lines as strace 6 prints them).
+inline std::set<std::string> strace_destinations(const std::filesystem::path& strace_log) {
+    std::set<std::string> found;
+    std::ifstream log(strace_log);
+    const std::regex ipv4(R"re(sin_addr=inet_addr\("([^"]+)"\))re");
+    const std::regex ipv6(R"re(inet_pton\(AF_INET6, "([^"]+)")re");
+    std::string line;
+    while (std::getline(log, line)) {
+        for (const auto* pattern : {&ipv4, &ipv6}) {
+            for (auto it = std::sregex_iterator(line.begin(), line.end(), *pattern); it != std::sregex_iterator();
+                 ++it) {
+                found.insert((*it)[1]);
+            }
+        }
+    }
+    return found;
 }
 
 }  // namespace rig::testing

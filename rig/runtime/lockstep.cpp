@@ -13,6 +13,8 @@ namespace rig {
 namespace {
 
 constexpr std::chrono::milliseconds kPollSlice{50};
+// Wall time between copies of the hello while a remote has not answered it.
+constexpr std::chrono::milliseconds kHelloRepeat{200};
 // Rounds at one instant before we call it a feedback loop between nodes.
 constexpr int kMaxRoundsPerInstant = 64;
 
@@ -272,7 +274,17 @@ std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
         published += step_in_process(remotes_[i], seq, t, shutdown, published_before);
     }
     const WallStopwatch waited;
+    WallStopwatch since_hello;
     while (outstanding > 0) {
+        // The hello again until every remote answered: a reader that matched our
+        // writer after the hello was written never gets it (Cyclone DDS starts a
+        // volatile reader after the last sample of the writer's first heartbeat,
+        // docs/controller-contract.md "Conformance findings"). It carries no time;
+        // a remote answers each copy, and the extra answers are ignored below.
+        if (hello && since_hello.elapsed() > kHelloRepeat) {
+            tick_writer_->publish(tick);
+            since_hello = WallStopwatch();
+        }
         ack_reader_->wait_for_data(std::min(kPollSlice, limit));
         for (const msg::ClockAck& ack : ack_reader_->take_all()) {
             if (ack.seq() != seq) continue;  // a late answer to an older tick

@@ -19,8 +19,9 @@
 //            input run again at the same t. A sample published at t is therefore
 //            seen by its readers at t; delays come only from the models.
 // Then the master jumps to the earliest next_wake of all nodes: idle simulated
-// time costs nothing. Tick 0 is a hello: the remote answers once all its
-// endpoints are matched, listing the topics it reads and writes; the master then
+// time costs nothing. Tick 0 is a hello, sent again every 0.2 s of wall time
+// until every remote answered (a reader matched after it was written may never
+// get it): the remote answers once all its endpoints are matched, listing the topics it reads and writes; the master then
 // waits until each of its writers reaches every reader of its topic and each of
 // its readers is reached by every writer. The first tick after the hello carries
 // how many readers each topic has, and a remote's writers must reach all of them
