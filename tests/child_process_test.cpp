@@ -9,8 +9,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fcntl.h>
+
+#include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <vector>
 #include <string>
 #include <thread>
 
@@ -105,6 +109,24 @@ TEST(ChildProcess, TheLogFileGetsStdoutAndStderr) {
     std::ifstream in(log);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_EQ(text, "out\nerr\n");
+}
+
+TEST(ChildProcess, InheritsNoDescriptorButItsStandardOnes) {
+    // An fd of the rig's without close-on-exec (as Fast DDS's sockets are):
+    // the controller must not get it.
+    const std::string marker = temp_path("inherited.txt");
+    std::ofstream(marker) << "rig's file\n";
+    const int fd = ::open(marker.c_str(), O_RDONLY);
+    ASSERT_GE(fd, 3);
+    const std::string log = temp_path("fds.log");
+    rig::ChildProcess lister({"/bin/sh", "-c", "ls /proc/$$/fd"}, log);
+    for (int i = 0; i < 2000 && !lister.exit_description(); ++i) std::this_thread::sleep_for(5ms);
+    ::close(fd);
+    std::ifstream in(log);
+    std::vector<std::string> fds;
+    for (std::string line; std::getline(in, line);) fds.push_back(line);
+    EXPECT_NE(std::find(fds.begin(), fds.end(), "1"), fds.end()) << "the listing did not run";
+    EXPECT_EQ(std::find(fds.begin(), fds.end(), std::to_string(fd)), fds.end()) << "fd " << fd << " was inherited";
 }
 
 TEST(ChildProcess, ItDiesWithTheRig) {

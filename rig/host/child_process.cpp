@@ -13,6 +13,18 @@
 #include "rig/runtime/clock.h"
 
 namespace rig {
+namespace {
+
+// Async-signal-safe (between fork and exec): FD_CLOEXEC on every fd from 3 up.
+bool mark_close_on_exec(int max_fd) {
+    for (int fd = 3; fd < max_fd; ++fd) {
+        const int flags = ::fcntl(fd, F_GETFD);
+        if (flags >= 0 && ::fcntl(fd, F_SETFD, flags | FD_CLOEXEC) != 0) return false;
+    }
+    return true;
+}
+
+}  // namespace
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path) {
     if (argv.empty()) throw std::runtime_error("empty command for a node process");
@@ -25,6 +37,9 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
     raw_argv.push_back(nullptr);
     const std::string log = log_path.string();
     const pid_t parent = ::getpid();
+    // For kernels without close_range (before 5.11): the fds to mark one by one.
+    const long open_max = ::sysconf(_SC_OPEN_MAX);
+    const int max_fd = static_cast<int>(open_max > 0 && open_max < 65536 ? open_max : 65536);
 
     // exec failure travels back over a close-on-exec pipe: EOF means exec succeeded.
     int report[2];
@@ -52,7 +67,12 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
         if (in < 0 || out < 0 || ::dup2(in, STDIN_FILENO) < 0 || ::dup2(out, STDOUT_FILENO) < 0 ||
             ::dup2(out, STDERR_FILENO) < 0) {
             err = errno;
+        } else if (::close_range(3, ~0U, CLOSE_RANGE_CLOEXEC) != 0 && !mark_close_on_exec(max_fd)) {
+            err = errno;
         } else {
+            // Nothing but stdin/out/err crosses exec: not the rig's DDS sockets
+            // (a controller holding them would keep the rig's ports bound after
+            // the rig is gone), not its trace files, not its ptys' masters.
             ::execvp(raw_argv[0], raw_argv.data());
             err = errno;
         }
