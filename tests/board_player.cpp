@@ -258,7 +258,7 @@ private:
         if (t < drive_until_s_) return;
         if (!pre_adjusted_) {
             pre_adjusted_ = true;
-            pump_l_min = pump_sum_l_min_ / pump_samples_;  // the plunger pump pulsates: its mean
+            pump_l_min = pump_sum_l_min_ / static_cast<double>(pump_samples_);  // the plunger pump pulsates: its mean
             const double opening = opening_for(options_.target_l_min, pump_l_min);
             std::cout << "board: pump " << pump_l_min << " L/min, pre-adjusting to " << opening << " %" << std::endl;
             opening_pct_ = opening;

@@ -747,7 +747,7 @@ TEST(SprayControllerEncoder, SpeedFromCaptureTimesIsExactAcrossTheTimerWrap) {
     for (TimeNs t = start_ns; t <= start_ns + 2'000'000'000LL; t += 10'000'000) {
         const double rolled_m = speed_m_s * rig::ns_to_seconds(t);
         const auto pulses = static_cast<std::uint64_t>(std::floor(rolled_m / pulse_m));
-        const auto edge_us = static_cast<std::uint64_t>(std::floor(pulses * pulse_m / speed_m_s * 1e6));
+        const auto edge_us = static_cast<std::uint64_t>(std::floor(static_cast<double>(pulses) * pulse_m / speed_m_s * 1e6));
         controller.on_encoder_count(static_cast<std::uint32_t>(pulses),
                                     static_cast<std::uint32_t>(edge_us & 0xffffffffULL), t);
         if (t >= start_ns + 300'000'000) {

@@ -124,6 +124,8 @@ TEST(RegisterMapDoc, TheBoardKeysDefaultsAreTheCodes) {
     expect_documented(rows, "board.silence_timeout_s", board.silence_timeout_s);
     expect_documented(rows, "board.failsafe_timeout_s", board.failsafe_timeout_s);
     for (const auto& row : rows) {
-        if (row.size() >= 2 && row[0] == "board.failsafe") EXPECT_EQ(row[1], std::string(rig::modbus::to_string(board.failsafe)));
+        if (row.size() >= 2 && row[0] == "board.failsafe") {
+            EXPECT_EQ(row[1], std::string(rig::modbus::to_string(board.failsafe)));
+        }
     }
 }
