@@ -27,11 +27,13 @@ int main(int argc, char** argv) {
     app.add_option("--clock", clock_mode, "lockstep (virtual time)")->check(CLI::IsMember({"lockstep"}));
     CLI11_PARSE(app, argc, argv);
     try {
+        // The context first: the node's readers and writers unregister from it
+        // when the node is destroyed, so it must outlive the node.
+        rig::DdsContext dds(domain_id, node_name);
         rig::controller::boundary::BoundaryControllerNode controller(
             node_name, rig::controller::boundary::load_boundary_node_config(config_file));
         rig::FollowerOptions options;
         options.node_name = node_name;
-        rig::DdsContext dds(domain_id, node_name);
         rig::ManualClock clock;
         return rig::run_lockstep_follower(controller, dds, clock, options);
     } catch (const std::exception& error) {

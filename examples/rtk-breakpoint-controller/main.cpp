@@ -166,8 +166,10 @@ int main(int argc, char** argv) {
         // --state-dir: this controller keeps no state between runs.
     }
     try {
-        RtkBreakpointController controller(node_name, setting(config, "antenna_to_nozzle_m").value_or(1.63));
+        // The context before the node: the node's readers and writers leave the
+        // context when the node is destroyed, so the context must outlive it.
         rig::DdsContext dds(domain, node_name);
+        RtkBreakpointController controller(node_name, setting(config, "antenna_to_nozzle_m").value_or(1.63));
         rig::FollowerOptions options;
         options.node_name = node_name;
         if (clock_mode == "realtime") return rig::run_realtime_follower(controller, dds, options);
