@@ -49,23 +49,31 @@ dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber) {
 }  // namespace
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
-    : context_(context), topic_name_(std::move(topic_name)), counts_as_output_(counts_as_output) {
-    writer_ = context_.publisher().create_datawriter(topic, project_writer_qos(context_.publisher()), &listener_,
-                                                     dds::StatusMask::publication_matched());
+    : context_(&context), topic_name_(std::move(topic_name)), counts_as_output_(counts_as_output) {
+    writer_ = context_->publisher().create_datawriter(topic, project_writer_qos(context_->publisher()), &listener_,
+                                                      dds::StatusMask::publication_matched());
     if (writer_ == nullptr) throw std::runtime_error("cannot create DDS writer on topic " + topic_name_);
-    context_.register_writer(this);
+    context_->register_writer(this);
 }
 
 WriterBase::~WriterBase() {
-    context_.unregister_writer(this);
-    context_.publisher().delete_datawriter(writer_);
+    if (context_ == nullptr) return;  // detached: the context deleted the DDS writer
+    context_->unregister_writer(this);
+    context_->publisher().delete_datawriter(writer_);
+}
+
+void WriterBase::detach() {
+    context_->publisher().delete_datawriter(writer_);
+    writer_ = nullptr;
+    context_ = nullptr;
 }
 
 bool WriterBase::write_raw(void* sample) {
+    if (writer_ == nullptr) return false;
     undelivered_.store(true);
     if (!writer_->write(sample)) return false;
     written_.fetch_add(1);
-    if (counts_as_output_) context_.note_published();
+    if (counts_as_output_) context_->note_published();
     return true;
 }
 
@@ -73,7 +81,7 @@ bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
     eprosima::fastrtps::Duration_t limit(static_cast<int32_t>(ns / 1'000'000'000),
                                          static_cast<uint32_t>(ns % 1'000'000'000));
-    if (writer_->wait_for_acknowledgments(limit) != ReturnCode_t::RETCODE_OK) return false;
+    if (writer_ == nullptr || writer_->wait_for_acknowledgments(limit) != ReturnCode_t::RETCODE_OK) return false;
     undelivered_.store(false);
     return true;
 }
@@ -81,24 +89,31 @@ bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
 void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.notify_data_arrived(); }
 
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
-    : context_(context), topic_name_(std::move(topic_name)), listener_(context) {
-    reader_ = context_.subscriber().create_datareader(
-        topic, project_reader_qos(context_.subscriber()), &listener_,
+    : context_(&context), topic_name_(std::move(topic_name)), listener_(context) {
+    reader_ = context_->subscriber().create_datareader(
+        topic, project_reader_qos(context_->subscriber()), &listener_,
         dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
     if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
-    context_.register_reader(this);
+    context_->register_reader(this);
 }
 
 ReaderBase::~ReaderBase() {
-    context_.unregister_reader(this);
-    context_.subscriber().delete_datareader(reader_);
+    if (context_ == nullptr) return;  // detached: the context deleted the DDS reader
+    context_->unregister_reader(this);
+    context_->subscriber().delete_datareader(reader_);
+}
+
+void ReaderBase::detach() {
+    context_->subscriber().delete_datareader(reader_);
+    reader_ = nullptr;
+    context_ = nullptr;
 }
 
 bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
     eprosima::fastrtps::Duration_t limit(static_cast<int32_t>(ns / 1'000'000'000),
                                          static_cast<uint32_t>(ns % 1'000'000'000));
-    return reader_->wait_for_unread_message(limit);
+    return reader_ != nullptr && reader_->wait_for_unread_message(limit);
 }
 
 namespace {
@@ -120,6 +135,7 @@ std::string prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
 }  // namespace
 
 bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
+    if (reader_ == nullptr) return false;
     dds::SampleInfo info;
     while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) {
@@ -140,7 +156,7 @@ bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
 std::uint64_t ReaderBase::received_count() const {
     // Read the unread count first: a sample taken in between is then counted in
     // neither, never twice (the count can only be low, and the waiter re-checks).
-    const std::uint64_t unread = reader_->get_unread_count();
+    const std::uint64_t unread = reader_ != nullptr ? reader_->get_unread_count() : 0;
     return taken_.load() + unread;
 }
 
@@ -190,7 +206,21 @@ DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_n
     }
 }
 
-DdsContext::~DdsContext() { delete_participant(participant_); }
+DdsContext::~DdsContext() {
+    // A node declared after its context outlives it: its endpoints lose their
+    // DDS entities here, with the participant, and their own destructors then
+    // leave the (gone) context alone.
+    std::vector<WriterBase*> writers;
+    std::vector<ReaderBase*> readers;
+    {
+        std::lock_guard lock(registry_mutex_);
+        writers.swap(writers_);
+        readers.swap(readers_);
+    }
+    for (WriterBase* writer : writers) writer->detach();
+    for (ReaderBase* reader : readers) reader->detach();
+    delete_participant(participant_);
+}
 
 dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*make_type)()) {
     if (auto it = topics_.find(name); it != topics_.end()) return it->second;

@@ -67,13 +67,18 @@ protected:
     bool write_raw(void* sample);
 
 private:
+    friend class DdsContext;
+    // The context is going away first (a node declared after it): the DDS writer
+    // goes with it, and this object only answers "not written" from now on.
+    void detach();
+
     struct MatchListener : dds::DataWriterListener {
         std::atomic<int> matched{0};
         void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override {
             matched.store(status.current_count);
         }
     };
-    DdsContext& context_;
+    DdsContext* context_;  // null once detached
     std::string topic_name_;
     MatchListener listener_;
     dds::DataWriter* writer_ = nullptr;
@@ -103,7 +108,7 @@ public:
 
     const std::string& topic_name() const { return topic_name_; }
     int matched_writers() const { return listener_.matched.load(); }
-    bool has_unread() const { return reader_->get_unread_count() > 0; }
+    bool has_unread() const { return reader_ != nullptr && reader_->get_unread_count() > 0; }
     // Samples that have arrived since the reader was created (taken or not).
     std::uint64_t received_count() const;
     // Blocks (wall time) until a sample is available or the timeout passes.
@@ -116,6 +121,10 @@ protected:
     bool take_raw(void* sample, std::string* writer_prefix = nullptr);
 
 private:
+    friend class DdsContext;
+    // As WriterBase::detach: the context goes first; nothing arrives any more.
+    void detach();
+
     struct MatchListener : dds::DataReaderListener {
         explicit MatchListener(DdsContext& owner) : context(owner) {}
         DdsContext& context;
@@ -125,7 +134,7 @@ private:
         }
         void on_data_available(dds::DataReader*) override;
     };
-    DdsContext& context_;
+    DdsContext* context_;  // null once detached
     std::string topic_name_;
     MatchListener listener_;
     dds::DataReader* reader_ = nullptr;
