@@ -18,7 +18,7 @@ namespace {
 
 // How often the attach wait looks at the wires: well under a person's
 // reaction, and /proc is scanned at most this often.
-constexpr TimeNs kAttachPollNs = 50'000'000;
+constexpr std::chrono::milliseconds kAttachPoll{50};
 
 constexpr const char* kFirstRequest = "its first valid Modbus request addressed to the rig";
 constexpr const char* kPtyOpened = "a process other than the rig opens the pty";
@@ -134,7 +134,6 @@ modbus::ModbusSlave* modbus_slave_of(BenchWires& wires) {
 }
 
 BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const std::function<void()>& watchdog) {
-    const RealtimeClock clock;
     const WallStopwatch waited;
     BoardAttachment attachment;
     modbus::ModbusSlave* slave = modbus_slave_of(wires);
@@ -170,7 +169,7 @@ BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const st
                                   " s: " + missing);
         }
         watchdog();
-        clock.sleep_until_ns(clock.now_ns() + kAttachPollNs);
+        pause_between_polls(kAttachPoll);
     }
     attachment.waited_s = waited.elapsed_s();
     return attachment;

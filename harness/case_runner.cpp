@@ -174,7 +174,7 @@ void record_own_topics(const std::vector<std::string>& topics, TraceRecorder& tr
                                   "its hello lists topic " + topic + ", but no writer of it was discovered within 10 s");
             }
             watchdog();
-            RealtimeClock().sleep_until_ns(RealtimeClock().now_ns() + seconds_to_ns(0.005));
+            pause_between_polls(std::chrono::milliseconds(5));
         }
         trace.record_raw(topic, *watchdog.writer_type(topic));
     }

@@ -32,6 +32,11 @@ std::chrono::steady_clock::time_point RealtimeClock::steady_time(TimeNs t) const
     return start_ + std::chrono::nanoseconds(t);
 }
 
+void pause_between_polls(std::chrono::milliseconds interval) {
+    const RealtimeClock clock;
+    clock.sleep_until_ns(std::chrono::duration_cast<std::chrono::nanoseconds>(interval).count());
+}
+
 WallStopwatch::WallStopwatch() : start_(std::chrono::steady_clock::now()) {}
 
 double WallStopwatch::elapsed_s() const {

@@ -65,4 +65,9 @@ private:
     std::chrono::steady_clock::time_point start_;
 };
 
+// A wall-time pause between two polls of something that signals no event (a
+// discovery record, a pty's far end being opened): start-up and bench waits,
+// never inside a lockstep round. Outside rig/, this is the way to wait.
+void pause_between_polls(std::chrono::milliseconds interval);
+
 }  // namespace rig
