@@ -114,50 +114,34 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
 
         TimeNs now_ns = 0;
         double startup_wall_s = 0.0;
-        TraceOutcome outcome;
-        try {
-            LockstepTimeouts timeouts;
-            timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
-            LockstepMaster master(dds, timeouts);
-            for (Node* node : {static_cast<Node*>(&plant), static_cast<Node*>(&ad300), static_cast<Node*>(&laser)}) {
-                master.add_local_node(*node);
-            }
-            if (session.has_controller_process()) {
-                master.add_remote_node("controller", [&session] { return session.controller_gone(); });
-            }
-            master.set_after_round([&](TimeNs t, int round) {
-                now_ns = t;
-                trace.drain(t, round);
-            });
-            master.set_watchdog([&] { check_run(spec, wall, dds, trace, now_ns); });
-            try {
-                master.start();
-                startup_wall_s = wall.elapsed_s();
-                while (master.advance(world.end_ns)) {
+        const TraceOutcome outcome = session.run_to_outcome(
+            [&] {
+                LockstepTimeouts timeouts;
+                timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
+                LockstepMaster master(dds, timeouts);
+                for (Node* node : {static_cast<Node*>(&plant), static_cast<Node*>(&ad300), static_cast<Node*>(&laser)}) {
+                    master.add_local_node(*node);
                 }
-                master.shutdown();
-            } catch (const NodeFailure&) {
-                master.shutdown(/*after_failure=*/true);
-                throw;
-            }
-            const std::string ended = session.stop_controller(std::chrono::milliseconds(3000));
-            if (ended != "process exited with status 0") {
-                throw NodeFailure(FailureKind::node_exited, "controller", "after shutdown: " + ended);
-            }
-            outcome.end_ns = world.end_ns;
-        } catch (const NodeFailure& failure) {
-            session.stop_controller(std::chrono::milliseconds(500));
-            outcome.status = failure.kind() == FailureKind::interrupted ? "interrupted" : "error";
-            outcome.error_kind = std::string(to_string(failure.kind()));
-            outcome.error = failure.what() + session.controller_log_tail();
-            outcome.end_ns = now_ns;
-        } catch (const std::exception& error) {
-            session.stop_controller(std::chrono::milliseconds(500));
-            outcome.status = "error";
-            outcome.error_kind = std::string(to_string(FailureKind::harness_error));
-            outcome.error = std::string("node 'harness': ") + error.what();
-            outcome.end_ns = now_ns;
-        }
+                if (session.has_controller_process()) {
+                    master.add_remote_node("controller", [&session] { return session.controller_gone(); });
+                }
+                master.set_after_round([&](TimeNs t, int round) {
+                    now_ns = t;
+                    trace.drain(t, round);
+                });
+                master.set_watchdog([&] { check_run(spec, wall, dds, trace, now_ns); });
+                try {
+                    master.start();
+                    startup_wall_s = wall.elapsed_s();
+                    while (master.advance(world.end_ns)) {
+                    }
+                    master.shutdown();
+                } catch (const NodeFailure&) {
+                    master.shutdown(/*after_failure=*/true);
+                    throw;
+                }
+            },
+            world.end_ns, now_ns);
         // Seed 001's reference controller ships as a program only: --in-process
         // leaves these cases to it, and says so.
         const bool asked_in_process = spec.controller.in_process.value_or(options.in_process);

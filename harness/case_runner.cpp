@@ -394,33 +394,16 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         facts.controller_mode = session.controller_mode();
         facts.in_process_refused = in_process_refused;
         Watchdog watchdog(spec, wall, dds, trace, session, now_ns);
-        TraceOutcome outcome;
-        try {
-            if (spec.mode == RunMode::lockstep) {
-                run_lockstep(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
-            } else {
-                run_realtime(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
-            }
-            const std::string ended = session.stop_controller(std::chrono::milliseconds(3000));
-            if (ended != "process exited with status 0") {
-                throw NodeFailure(FailureKind::node_exited, "controller", "after shutdown: " + ended);
-            }
-            circuit.advance_to(world.end_ns);
-            outcome.end_ns = world.end_ns;
-        } catch (const NodeFailure& failure) {
-            session.stop_controller(std::chrono::milliseconds(500));
-            outcome.status = failure.kind() == FailureKind::interrupted ? "interrupted" : "error";
-            outcome.error_kind = std::string(to_string(failure.kind()));
-            outcome.error = failure.what() + session.controller_log_tail();
-            outcome.end_ns = now_ns;
-        } catch (const std::exception& error) {
-            // The rig's own side failed (a DDS write, the trace): the case cannot be judged on the controller.
-            session.stop_controller(std::chrono::milliseconds(500));
-            outcome.status = "error";
-            outcome.error_kind = std::string(to_string(FailureKind::harness_error));
-            outcome.error = std::string("node 'harness': ") + error.what();
-            outcome.end_ns = now_ns;
-        }
+        const TraceOutcome outcome = session.run_to_outcome(
+            [&] {
+                if (spec.mode == RunMode::lockstep) {
+                    run_lockstep(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
+                } else {
+                    run_realtime(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
+                }
+                circuit.advance_to(world.end_ns);
+            },
+            world.end_ns, now_ns);
         // Whatever the ending, the spray on the ground so far is part of the record.
         trace.file().record_deposition(circuit.deposition());
         trace.file().record_landing_edges(circuit.landing_edges());

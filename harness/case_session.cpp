@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "rig/runtime/lockstep.h"
 #include "rig/wire/hid_board.h"
 #include "rig/wire/modbus_protocol.h"
 
@@ -183,6 +184,32 @@ std::optional<std::string> CaseSession::controller_gone() {
 
 std::string CaseSession::stop_controller(std::chrono::milliseconds grace) {
     return controller_ ? controller_->stop(grace) : std::string("process exited with status 0");
+}
+
+TraceOutcome CaseSession::run_to_outcome(const std::function<void()>& run, TimeNs end_ns, const TimeNs& now_ns) {
+    TraceOutcome outcome;
+    try {
+        run();
+        const std::string ended = stop_controller(std::chrono::milliseconds(3000));
+        if (ended != "process exited with status 0") {
+            throw NodeFailure(FailureKind::node_exited, "controller", "after shutdown: " + ended);
+        }
+        outcome.end_ns = end_ns;
+    } catch (const NodeFailure& failure) {
+        stop_controller(std::chrono::milliseconds(500));
+        outcome.status = failure.kind() == FailureKind::interrupted ? "interrupted" : "error";
+        outcome.error_kind = std::string(to_string(failure.kind()));
+        outcome.error = failure.what() + controller_log_tail();
+        outcome.end_ns = now_ns;
+    } catch (const std::exception& error) {
+        // The rig's own side failed (a DDS write, the trace): the case cannot be judged on the controller.
+        stop_controller(std::chrono::milliseconds(500));
+        outcome.status = "error";
+        outcome.error_kind = std::string(to_string(FailureKind::harness_error));
+        outcome.error = std::string("node 'harness': ") + error.what();
+        outcome.end_ns = now_ns;
+    }
+    return outcome;
 }
 
 std::string CaseSession::controller_log_tail(std::size_t max_lines) const {

@@ -10,7 +10,10 @@
 #include <string>
 #include <vector>
 
+#include <functional>
+
 #include "harness/case_spec.h"
+#include "harness/trace_file.h"
 #include "harness/in_process_controller.h"
 #include "rig/host/child_process.h"
 #include "rig/runtime/clock.h"
@@ -70,6 +73,11 @@ public:
     std::optional<std::string> controller_gone();
     // Waits up to `grace` for it to end by itself, then stops it; how it ended.
     std::string stop_controller(std::chrono::milliseconds grace);
+    // Runs the case (`run`: the time mode's runner) and ends the controller, and
+    // says how the run ended for the trace: completed at `end_ns` when the
+    // controller also ended cleanly; else the node that failed and why (with the
+    // tail of the controller's log), or the rig's own failure, at `now_ns`.
+    TraceOutcome run_to_outcome(const std::function<void()>& run, TimeNs end_ns, const TimeNs& now_ns);
     // The last lines of the controller's log, for error messages.
     std::string controller_log_tail(std::size_t max_lines = 6) const;
     // A bench wire whose far end does not take what the rig writes: the GNSS pty
