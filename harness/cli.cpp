@@ -19,6 +19,7 @@
 #include "harness/bench_hid.h"
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
+#include "harness/trace_mcap.h"
 #include "harness/case_runner.h"
 #include "harness/case_world.h"
 #include "harness/html_report.h"
@@ -158,6 +159,7 @@ int main(int argc, char** argv) {
     const rig::harness::PtyBenchCommand pty_bench(app);
     const rig::harness::HidBenchCommand hid_bench(app);
     const rig::harness::EmulateBenchCommand emulate_bench(app);
+    const rig::harness::McapCommand mcap_command(app);
 
     rig::DdsCheckOptions check_options;
     check_options.echo_executable = own_directory() / "rig";
@@ -193,6 +195,7 @@ int main(int argc, char** argv) {
     if (pty_bench.parsed()) return pty_bench.run();
     if (hid_bench.parsed()) return hid_bench.run();
     if (emulate_bench.parsed()) return emulate_bench.run();
+    if (mcap_command.parsed()) return mcap_command.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
         if (domain_option->count() > 0) {
