@@ -38,6 +38,11 @@ constexpr double kVehicleTruthRateHz = 20.0;
 constexpr double kHydraulicsTruthRateHz = 100.0;
 // SCHED_FIFO priority the harness asks for in real-time runs (the controller asks for 40).
 constexpr int kRealtimePriority = 50;
+// The threads that carry the bench wires' bytes (the Modbus slave answering a
+// board's polls, the pty forwarder): above the controller, so a board's request
+// is answered on time however busy the machine, below the master, whose
+// deadlines make the devices' timing.
+constexpr int kWireThreadPriority = 45;
 // A bench wire whose bytes wait unread this long has nobody on its far end.
 constexpr std::chrono::milliseconds kWireUnreadBound{2000};
 
@@ -215,11 +220,30 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     }
 }
 
+// The bench wires' threads at SCHED_FIFO `priority`; what was granted, for the run's facts.
+std::string raise_wire_threads(BenchWires& wires, int priority) {
+    std::vector<std::string> refused;
+    int raised = 0;
+    const auto raise = [&](const std::string& what, const std::string& why_not) {
+        if (why_not.empty()) ++raised;
+        else refused.push_back(what + ": " + why_not);
+    };
+    if (wires.modbus_link) raise("pty forwarder", wires.modbus_link->raise_to_realtime(priority));
+    if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(wires.board_io.get())) {
+        raise("Modbus slave", modbus_wire->slave().raise_to_realtime(priority));
+    }
+    if (raised == 0 && refused.empty()) return {};
+    std::string text = "; wire threads: " + std::to_string(raised) + " at SCHED_FIFO " + std::to_string(priority);
+    for (const std::string& why : refused) text += ", " + why;
+    return text;
+}
+
 // Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
 void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
     facts.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
+    facts.realtime_scheduling += raise_wire_threads(session.wires(), kWireThreadPriority);
     RealtimeMaster master(dds, timeouts_of(spec));
     for (Node* node : nodes.all) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });

@@ -744,18 +744,53 @@ std::string area_shading(const CaseFigures& figures, bool with_labels) {
     return script;
 }
 
+// Fig. 15's scale. Where the sprayer stood with its nozzles open (starting a
+// pass from standstill, stopping at the breakpoint) a few rows get many times
+// what a moving boom leaves; a scale set by them flattens everything the figure
+// is about. The scale is cut at kDoseScaleOverMedian times the median of the
+// rows that got spray, and the rows above it are counted on the figure.
+constexpr double kDoseScaleOverMedian = 3.0;
+
+struct DoseScale {
+    double top = 0.0;             // the y axis' top, uL/cm^2 (0: nothing sprayed)
+    std::size_t rows_above = 0;   // rows whose total is off the scale
+    double highest = 0.0;         // the largest total
+};
+
+DoseScale dose_scale(const std::vector<DoseRow>& rows) {
+    std::vector<double> sprayed;
+    DoseScale scale;
+    for (const DoseRow& row : rows) {
+        if (row.total > 0.0) sprayed.push_back(row.total);
+        scale.highest = std::max(scale.highest, row.total);
+    }
+    if (sprayed.empty()) return scale;
+    std::nth_element(sprayed.begin(), sprayed.begin() + static_cast<std::ptrdiff_t>(sprayed.size() / 2), sprayed.end());
+    const double cut = kDoseScaleOverMedian * sprayed[sprayed.size() / 2];
+    scale.top = std::min(scale.highest, cut);
+    for (const DoseRow& row : rows) scale.rows_above += row.total > cut ? 1 : 0;
+    return scale;
+}
+
+// The label on a figure whose scale cut rows off.
+std::string off_scale_label(int tag, const DoseScale& scale, const std::string& highest_text) {
+    if (scale.rows_above == 0) return {};
+    return "set label " + std::to_string(tag) + " " +
+           gnuplot_string(std::to_string(scale.rows_above) + " row" + (scale.rows_above == 1 ? "" : "s") +
+                          " off the scale (up to " + highest_text + ") where the sprayer stood spraying") +
+           " at graph 0.99, graph 0.72 right front boxed textcolor rgb '#8d1010'\n" +
+           "set style textbox opaque fillcolor rgb 'white' noborder\n";
+}
+
 // Row deposits across the breakpoint, as the paper's Fig. 15 (before its normalisation).
 std::optional<Panel> dose_panel(const CaseFigures& figures, const std::vector<DoseRow>& rows) {
     if (rows.empty()) return std::nullopt;
+    const DoseScale scale = dose_scale(rows);
     Extent y_extent;
     y_extent.include(0.0);
+    y_extent.include(scale.top);
     std::vector<std::vector<double>> data;
-    for (const DoseRow& row : rows) {
-        y_extent.include(row.first_pass);
-        y_extent.include(row.continuation);
-        y_extent.include(row.total);
-        data.push_back({row.along_m, row.first_pass, row.continuation, row.total});
-    }
+    for (const DoseRow& row : rows) data.push_back({row.along_m, row.first_pass, row.continuation, row.total});
     Panel panel;
     panel.caption = "Dose per row along the track across the breakpoint";
     panel.width = 860;
@@ -770,6 +805,7 @@ std::optional<Panel> dose_panel(const CaseFigures& figures, const std::vector<Do
     script += "set yrange " + y_extent.range(0.0, 0.25) + "\n";
     script += "set key outside top center horizontal\n";
     script += area_shading(figures, true);
+    script += off_scale_label(3, scale, shown_number(scale.highest, 3) + " uL/cm^2");
     script += vertical_marker(2, figures.breakpoint_along_m, kBreakpointColor, "1", "breakpoint", false, 0.82);
     script += "plot $dose using 1:2 with linespoints lw 1.5 pt 7 ps 0.5 lc " + rgb(kFirstPassColor) + " title " +
               gnuplot_string("first pass") + ", $dose using 1:3 with linespoints lw 1.5 pt 7 ps 0.5 lc " +
@@ -784,6 +820,9 @@ std::optional<Panel> normalised_dose_panel(const CaseFigures& figures, const std
     Extent totals;
     for (const DoseRow& row : rows) totals.include(row.total);
     if (totals.empty() || !(totals.high > totals.low)) return std::nullopt;  // Eq. 9 undefined
+    // Eq. 9 as the paper defines it (its max is a standing row's, if any), shown on the same cut scale.
+    const DoseScale scale = dose_scale(rows);
+    const double top = (scale.top - totals.low) / (totals.high - totals.low);
     std::vector<Point> normalised;
     for (const DoseRow& row : rows) {
         normalised.push_back({row.along_m, (row.total - totals.low) / (totals.high - totals.low)});
@@ -799,8 +838,9 @@ std::optional<Panel> normalised_dose_panel(const CaseFigures& figures, const std
     script += "set ylabel " + gnuplot_string("normalised (Eq. 9)") + "\n";
     script += "set lmargin 12\nset rmargin 4\n";
     script += "set xrange " + dose_x_extent(figures, rows).range(0.02, 0.02) + "\n";
-    script += "set yrange [0:1.1]\nset ytics 0.25\nset key off\n";
+    script += "set yrange [0:" + exact_number(std::max(top, 0.05) * 1.1) + "]\nset key off\n";
     script += area_shading(figures, false);
+    script += off_scale_label(3, scale, "1");
     script += vertical_marker(2, figures.breakpoint_along_m, kBreakpointColor, "1", "", false);
     script += "plot $normalised using 1:2 with linespoints lw 2 pt 5 ps 0.5 lc " + rgb(kTotalColor) + " notitle\n";
     return panel;
@@ -886,7 +926,10 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; co
 h1 { font-size: 1.7em; margin: 0 0 0.3em 0; }
 h2 { font-size: 1.3em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2.2em; }
 h3 { font-size: 1.05em; margin: 1.2em 0 0.4em 0; }
-table { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
+/* A table or figure wider than the screen (a phone's 390 px) scrolls inside its
+   own box; the page never does, and figures are never shrunk below the size
+   their text was drawn for (gnuplot's 11 px). */
+table { border-collapse: collapse; margin: 0.4em 0 0.8em 0; display: block; overflow-x: auto; max-width: 100%; }
 th, td { border: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
 th { background: #f3f3f3; font-weight: 600; }
 .num { font-family: ui-monospace, "DejaVu Sans Mono", Menlo, Consolas, monospace; font-variant-numeric: tabular-nums;
@@ -912,11 +955,15 @@ td.expected { background: #fdf6dd; }
 .notice { border: 1px solid #e0b000; background: #fff9e0; padding: 0.4em 0.8em; }
 pre { white-space: pre-wrap; word-break: break-word; margin: 0.3em 0;
       font-family: ui-monospace, "DejaVu Sans Mono", Menlo, Consolas, monospace; }
-figure { margin: 1.2em 0; }
-#suite figure { margin: 0.4em 0; max-width: 100%; }
+figure { margin: 1.2em 0; max-width: 100%; overflow-x: auto; }
+#suite figure { margin: 0.4em 0; }
 .panels { display: flex; flex-wrap: wrap; gap: 0.8em; align-items: flex-start; }
 .panels.stacked { flex-direction: column; flex-wrap: nowrap; }
-svg { max-width: 100%; height: auto; }
+svg { max-width: none; height: auto; flex: none; }
+@media (max-width: 600px) {
+  body { padding: 0 0.6em; margin-top: 0.8em; }
+  .metric-line .name { min-width: 0; margin-right: 0.5em; }
+}
 figcaption { color: #555; font-size: 0.92em; margin-top: 0.3em; max-width: 70em; }
 .figure-error { border: 1px dashed #b00000; background: #fff6f6; padding: 0.5em 0.8em; max-width: 60em; }
 .nav { font-size: 0.9em; }
@@ -1146,8 +1193,15 @@ std::string dose_figure(PageBuilder& page, std::size_t index, const CaseResult& 
     }
     figure += "</div>\n<figcaption>Dose per row of the deposition grid, summed across the boom, as in the paper's "
               "Fig. 15: the first pass (before the breakpoint stop), the continuation (after the resume) and their "
-              "total; shaded areas as the harness classified them; below, the total normalised by Eq. 9."
-              "</figcaption>\n";
+              "total; shaded areas as the harness classified them; below, the total normalised by Eq. 9.";
+    if (const DoseScale scale = dose_scale(rows); scale.rows_above > 0) {
+        figure += " The scale is cut at " + std::to_string(static_cast<int>(kDoseScaleOverMedian)) +
+                  " times the median row: " + std::to_string(scale.rows_above) + " row" +
+                  (scale.rows_above == 1 ? "" : "s") + " reach up to " + html(shown_number(scale.highest, 3)) +
+                  " uL/cm<sup>2</sup>, where the sprayer stood with its nozzles open (starting from standstill, "
+                  "stopping at the breakpoint): a filter paper there is soaked, and Eq. 9's maximum is theirs.";
+    }
+    figure += "</figcaption>\n";
     figure += area_table(figures);
     return figure + "</figure>\n";
 }

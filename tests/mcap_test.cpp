@@ -1,5 +1,5 @@
 // MCAP (harness/trace_mcap.h, harness/mcap_writer.h): `rig mcap` writes a run's
-// traces as MCAP, and the official reader (@mcap/core, tests/mcap/, installed by
+// traces as MCAP, and the official reader (@mcap/core, tests/js/, installed by
 // scripts/setup) reads them both ways a tool does, indexed as Foxglove opens a
 // file and streamed with every CRC checked; every sample of the trace, the
 // forged ones included, is there with its time, topic and JSON. Plus the
@@ -28,21 +28,7 @@ using rig::testing::read_all;
 
 namespace {
 
-struct Shell {
-    int exit_code = -1;
-    std::string output;  // stdout and stderr
-};
-
-Shell shell(const std::string& command) {
-    Shell result;
-    if (FILE* pipe = ::popen((command + " 2>&1").c_str(), "r")) {
-        char buffer[4096];
-        while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
-        const int status = ::pclose(pipe);
-        result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-    return result;
-}
+rig::testing::ShellResult shell(const std::string& command) { return rig::testing::run_shell(command + " 2>&1"); }
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 
@@ -120,12 +106,12 @@ TEST(McapWriter, TheSchemaCoversEveryShapeASampleTook) {
 TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
     const fs::path dir = fresh_dir("mcap-official-reader");
     const fs::path out = dir / "out";
-    const Shell run = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " run " +
+    const auto run = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " run " +
                             quoted(RIG_SOURCE_DIR "/cases/table5-6-continuation/continuation-6kmh.yaml") + " " +
                             quoted(RIG_SOURCE_DIR "/cases/faulty-controllers/forges-truth-topic.yaml") +
                             " --out " + quoted(out));
     ASSERT_EQ(run.exit_code, 0) << run.output;
-    const Shell mcap = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " mcap " + quoted(out));
+    const auto mcap = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " mcap " + quoted(out));
     ASSERT_EQ(mcap.exit_code, 0) << mcap.output;
 
     std::size_t traces = 0;
@@ -141,10 +127,10 @@ TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
         ++traces;
 
         const fs::path lines_file = dir / (name + ".lines");
-        const Shell read = shell("cd " + quoted(RIG_MCAP_READER_DIR) + " && node read_mcap.mjs " + quoted(file) + " " +
+        const auto read = shell("cd " + quoted(RIG_JS_TOOLS_DIR) + " && node read_mcap.mjs " + quoted(file) + " " +
                                  quoted(lines_file));
         ASSERT_EQ(read.exit_code, 0) << "the official reader failed (is @mcap/core installed? scripts/setup runs npm ci "
-                                        "in " RIG_MCAP_READER_DIR "):\n"
+                                        "in " RIG_JS_TOOLS_DIR "):\n"
                                      << read.output;
         const nlohmann::json summary = nlohmann::json::parse(read.output);
         const std::vector<std::string> expected = trace_lines(trace);
@@ -183,7 +169,7 @@ TEST(McapCommand, BadInputsAreClearErrors) {
     std::ofstream(not_a_trace) << "not a database\n";
     const std::string rig = quoted(RIG_BINARY_DIR "/bin/rig");
 
-    Shell result = shell(rig + " mcap " + quoted(not_a_trace));
+    auto result = shell(rig + " mcap " + quoted(not_a_trace));
     EXPECT_EQ(result.exit_code, 1) << result.output;
     EXPECT_NE(result.output.find("rig mcap: " + not_a_trace.string()), std::string::npos) << result.output;
     EXPECT_FALSE(fs::exists(dir / "trace.mcap"));

@@ -1,5 +1,6 @@
 #include "rig/runtime/realtime.h"
 
+#include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
@@ -52,6 +53,14 @@ SchedulingReport request_realtime_scheduling(int priority) {
         report.detail += std::string(", memory not locked (") + std::strerror(errno) + ")";
     }
     return report;
+}
+
+std::string raise_thread_to_realtime(std::thread& thread, int priority) {
+    if (!thread.joinable()) return "no thread";
+    sched_param param{};
+    param.sched_priority = priority;
+    const int error = pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
+    return error == 0 ? std::string() : std::string("SCHED_FIFO refused: ") + std::strerror(error);
 }
 
 RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), remotes_(dds, timeouts) {}

@@ -21,6 +21,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "rig/runtime/clock.h"
@@ -56,6 +57,10 @@ struct SchedulingReport {
 // and the run goes on without it. Also sets the timer slack to 1 ns, so
 // deadline waits are not rounded up by the kernel's default 50 us.
 SchedulingReport request_realtime_scheduling(int priority);
+// SCHED_FIFO at `priority` for another, already running thread (a wire's
+// server or forwarder: threads started before request_realtime_scheduling()
+// do not inherit it). "" when granted, else why not.
+std::string raise_thread_to_realtime(std::thread& thread, int priority);
 
 class RealtimeMaster {
 public:
