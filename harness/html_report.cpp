@@ -115,9 +115,10 @@ std::optional<std::string> read_file(const fs::path& path) {
 
 // ---------------------------------------------------------------- case facts
 
-enum class Verdict { pass, fail, expected_failure_ok };
+enum class Verdict { pass, fail, expected_failure_ok, invalid };
 
 Verdict verdict_of(const CaseResult& result) {
+    if (case_invalid(result)) return Verdict::invalid;
     if (!case_passed(result)) return Verdict::fail;
     return result.expected_failure ? Verdict::expected_failure_ok : Verdict::pass;
 }
@@ -128,6 +129,9 @@ std::string verdict_badge(Verdict verdict) {
         case Verdict::expected_failure_ok:
             return "<span class=\"badge xfail\" title=\"broke exactly the limits the case expects to "
                    "break\">expected failure OK</span>";
+        case Verdict::invalid:
+            return "<span class=\"badge invalid\" title=\"the rig was overloaded: the run cannot judge the "
+                   "controller\">INVALID</span>";
         case Verdict::fail: break;
     }
     return "<span class=\"badge fail\">FAIL</span>";
@@ -942,6 +946,7 @@ th { background: #f3f3f3; font-weight: 600; }
 .badge.pass { background: #dcf3dc; color: #17611a; }
 .badge.fail { background: #fbd3d3; color: #8d1010; }
 .badge.xfail { background: #fcefc7; color: #765600; }
+.badge.invalid { background: #e8dcf5; color: #4b1d7a; }
 .over { color: #b00000; font-weight: 700; }
 td.over { background: #fdecec; }
 .expected { color: #8a6400; }
@@ -971,7 +976,12 @@ figcaption { color: #555; font-size: 0.92em; margin-top: 0.3em; max-width: 70em;
 )";
 
 std::string verdict_text(const RunSummary& summary) {
-    const int total = summary.passed + summary.failed;
+    const int total = summary.passed + summary.failed + summary.invalid;
+    if (summary.invalid > 0) {
+        return "<p class=\"verdict fail\">" + std::to_string(summary.failed) + " of " + std::to_string(total) +
+               " failed, " + std::to_string(summary.invalid) +
+               " invalid (the rig was overloaded: not judged, run again on a quieter machine)</p>\n";
+    }
     if (summary.failed == 0) {
         return "<p class=\"verdict pass\">All " + std::to_string(total) + " case" + (total == 1 ? "" : "s") +
                " passed</p>\n";
@@ -983,10 +993,11 @@ std::string verdict_text(const RunSummary& summary) {
 std::string run_numbers_table(const RunSummary& summary) {
     const std::string speed_up =
         summary.wall_seconds > 0.0 ? shown_number(summary.sim_seconds / summary.wall_seconds, 3) + "\u00d7" : "\u2013";
-    std::string table = "<table class=\"run\">\n<tr><th>passed</th><th>failed</th><th>simulated</th><th>wall</th>"
+    std::string table = "<table class=\"run\">\n<tr><th>passed</th><th>failed</th><th>invalid</th><th>simulated</th><th>wall</th>"
                         "<th>speed-up (simulated / wall)</th></tr>\n";
     table += "<tr><td class=\"num\">" + std::to_string(summary.passed) + "</td><td class=\"num" +
-             (summary.failed > 0 ? " over" : "") + "\">" + std::to_string(summary.failed) + "</td><td class=\"num\">" +
+             (summary.failed > 0 ? " over" : "") + "\">" + std::to_string(summary.failed) + "</td><td class=\"num" +
+             (summary.invalid > 0 ? " over" : "") + "\">" + std::to_string(summary.invalid) + "</td><td class=\"num\">" +
              fixed_number(summary.sim_seconds, 1) + " s</td><td class=\"num\">" + fixed_number(summary.wall_seconds, 1) +
              " s</td><td class=\"num\">" + speed_up + "</td></tr>\n</table>\n";
     return table;
@@ -1046,6 +1057,7 @@ std::string case_facts(const CaseResult& result) {
         }
         row("controller", placed);
     }
+    if (result.rig_lateness.is_object()) row("rig lateness", html(rig_lateness_summary(result.rig_lateness)));
     row("trace", result.trace_path.empty() ? std::string("<span class=\"muted\">none</span>")
                                            : "<span class=\"mono\">" + html(result.trace_path) + "</span>");
     row("trace_sha256", result.trace_sha256.empty() ? std::string("<span class=\"muted\">none</span>")
@@ -1210,7 +1222,11 @@ std::string case_section(PageBuilder& page, std::size_t index, const CaseResult&
     std::string section = "<section class=\"case\" id=\"" + case_anchor(index) + "\">\n";
     section += "<h2>" + std::to_string(index + 1) + ". " + html(result.name) + " " + verdict_badge(verdict_of(result)) +
                "</h2>\n";
-    if (!result.error.empty()) {
+    if (verdict_of(result) == Verdict::invalid) {
+        section += "<div class=\"error-box\"><strong>Invalid: this run cannot judge the controller (" +
+                   html(result.error_kind) + "):</strong>\n<pre>" + html(result.error) +
+                   "</pre>The metrics below are reported, not judged; run the case again on a quieter machine.</div>\n";
+    } else if (!result.error.empty()) {
         section += "<div class=\"error-box\"><strong>The case did not run to the end (" + html(result.error_kind) +
                    (verdict_of(result) == Verdict::expected_failure_ok ? ", as the case expects" : "") +
                    "):</strong>\n<pre>" + html(result.error) + "</pre>The trace keeps every sample up to it.</div>\n";
@@ -1323,7 +1339,8 @@ HtmlReport render_html_report(const std::vector<CaseResult>& results, const std:
     out += "<meta charset=\"utf-8\"/>\n";
     out += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n";
     out += "<title>" + html(options.title) + ": " + std::to_string(summary.passed) + " passed, " +
-           std::to_string(summary.failed) + " failed</title>\n";
+           std::to_string(summary.failed) + " failed" +
+           (summary.invalid > 0 ? ", " + std::to_string(summary.invalid) + " invalid" : "") + "</title>\n";
     out += "<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
     out += "<header>\n<h1>" + html(options.title) + "</h1>\n";
     out += verdict_text(summary) + run_numbers_table(summary);

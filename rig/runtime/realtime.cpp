@@ -89,13 +89,22 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
     if (!started_) throw std::logic_error("RealtimeMaster::run_until before start");
     for (;;) {
         const std::uint64_t arrivals_seen = dds_.arrival_count();
+        if (clock_.now_ns() >= stall_at_ns_) {
+            stall_at_ns_ = kNever;
+            clock_.sleep_until_ns(clock_.now_ns() + stall_for_ns_);
+        }
         const TimeNs now = clock_.now_ns();
         if (now >= end_ns) return;
         for (Local& local : locals_) {
             if (local.next_wake_ns <= now) {
-                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
-                if (local.next_wake_ns > 0) local.late_ns.push_back(now - local.next_wake_ns);
+                // Late by when its step began: a long step of a node before it in
+                // this pass delays its emission too.
                 const TimeNs step_started_ns = clock_.now_ns();
+                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
+                if (local.next_wake_ns > 0) {
+                    local.late_ns.push_back(step_started_ns - local.next_wake_ns);
+                    lateness_.record(local.node->name(), local.next_wake_ns, step_started_ns);
+                }
                 local.next_wake_ns = local.node->step(now);
                 local.step_ns.push_back(clock_.now_ns() - step_started_ns);
             } else if (local.node->has_unread_input()) {
