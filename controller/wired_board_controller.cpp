@@ -1,8 +1,26 @@
 #include "controller/wired_board_controller.h"
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 
 namespace rig::controller {
+
+modbus::MasterTimeouts rtu_master_timeouts(int baud) {
+    // libmodbus's own defaults (0.5 s response, 0.5 s between bytes) are for a
+    // line of unknown speed. This loop runs at 100 Hz and times the valve's
+    // relay pulses, and every wait here holds it: a response whose first byte
+    // was lost to noise left it waiting the whole byte timeout for bytes that
+    // never came (0.53 s, cases/wire-faults/modbus-line-noise-wired-rtu.yaml),
+    // which lengthened relay pulses and broke the flow. So the waits are what
+    // the line needs: 20 ms between bytes, since USB-serial adapters deliver
+    // a frame in chunks up to ~16 ms apart; and for the first byte, a whole
+    // 256-byte ADU at the baud (10 bits a byte) plus 100 ms for the slave's
+    // turnaround on a loaded machine (only a response lost whole waits for it).
+    constexpr double kMaxAduBytes = 256.0;
+    const auto frame_ms = static_cast<long>(std::ceil(kMaxAduBytes * 10.0 * 1000.0 / std::max(baud, 1)));
+    return modbus::MasterTimeouts{std::chrono::milliseconds(100 + frame_ms), std::chrono::milliseconds(20)};
+}
 
 WiredBoardController::WiredBoardController(std::string node_name, ControllerConfig config,
                                            const std::filesystem::path& state_dir, WiredBoardOptions options)
@@ -15,7 +33,7 @@ void WiredBoardController::configure(DdsContext& /*dds*/) {
     if (options_.nmea_port.empty()) throw std::runtime_error("wired mode needs the NMEA serial port");
     nmea_port_ = std::make_unique<SerialPort>(options_.nmea_port, options_.nmea_line);
     if (options_.modbus_rtu) {
-        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_rtu);
+        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_rtu, rtu_master_timeouts(options_.modbus_rtu->line.baud));
     } else if (options_.modbus_tcp) {
         board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_tcp);
     } else {
@@ -26,20 +44,24 @@ void WiredBoardController::configure(DdsContext& /*dds*/) {
 void WiredBoardController::activate(TimeNs now_ns) {
     firmware_.start(now_ns);
     next_poll_ns_ = now_ns;
+    last_exchange_ns_ = now_ns;
 }
 
 template <class Call>
 auto WiredBoardController::with_retries(Call call) {
     for (int attempt = 0;; ++attempt) {
+        const TimeNs started_ns = attempt_clock_.now_ns();
         try {
             return call();
         } catch (const modbus::ModbusMasterError& error) {
+            longest_failed_attempt_ns_ = std::max(longest_failed_attempt_ns_, attempt_clock_.now_ns() - started_ns);
             // A frame lost on the line is retried; a slave that refuses (an exception
             // response, the wrong map) is not going to change its mind.
-            const bool transient = error.kind() == modbus::ModbusMasterError::Kind::timeout ||
-                                   error.kind() == modbus::ModbusMasterError::Kind::bad_response;
+            const bool timeout = error.kind() == modbus::ModbusMasterError::Kind::timeout;
+            const bool transient = timeout || error.kind() == modbus::ModbusMasterError::Kind::bad_response;
             if (!transient || attempt >= options_.modbus_retries) throw;
             ++retries_used_;
+            ++(timeout ? timeouts_retried_ : bad_responses_retried_);
         }
     }
 }
@@ -112,9 +134,24 @@ TimeNs WiredBoardController::step(TimeNs now_ns) {
     // than planned and a correction within the motor's start delay did nothing.)
     read_nmea(now_ns);
     const TimeNs firmware_wake = firmware_.update(now_ns);
-    write_outputs(now_ns);
-    if (now_ns >= next_poll_ns_) {
-        poll_board(now_ns);
+    try {
+        write_outputs(now_ns);
+        if (now_ns >= next_poll_ns_) {
+            poll_board(now_ns);
+            next_poll_ns_ = next_period_boundary(now_ns, poll_period_ns_);
+        }
+        last_exchange_ns_ = now_ns;
+    } catch (const modbus::ModbusMasterError& error) {
+        // An exchange that failed after its retries is a lost poll, as on a
+        // noisy line: the firmware keeps the last inputs, the outputs are
+        // written again at the next step (written_* are unchanged), and the
+        // poll comes at the next period. Only a board that has answered
+        // nothing for modbus_lost_after is lost, and ends the run.
+        const bool transient = error.kind() == modbus::ModbusMasterError::Kind::timeout ||
+                               error.kind() == modbus::ModbusMasterError::Kind::bad_response;
+        const TimeNs lost_after_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(options_.modbus_lost_after).count();
+        if (!transient || now_ns - last_exchange_ns_ > lost_after_ns) throw;
+        ++exchanges_lost_;
         next_poll_ns_ = next_period_boundary(now_ns, poll_period_ns_);
     }
     for (const std::string& notice : firmware_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
@@ -125,6 +162,12 @@ TimeNs WiredBoardController::step(TimeNs now_ns) {
 void WiredBoardController::shutdown() {
     // Leave the plant safe: relays off, sections closed, pump unloaded.
     if (!board_) return;
+    if (retries_used_ > 0) {
+        std::cerr << name_ << ": modbus: " << retries_used_ << " requests retried (" << timeouts_retried_
+                  << " timeouts, " << bad_responses_retried_ << " bad responses), " << exchanges_lost_
+                  << " exchanges lost after their retries (lost polls); the longest failed attempt held the loop "
+                  << ns_to_seconds(longest_failed_attempt_ns_) * 1000.0 << " ms\n";
+    }
     try {
         io::ActuatorCommands safe;
         safe.unloading_valve_open = true;

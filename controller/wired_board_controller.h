@@ -19,6 +19,7 @@
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
 #include "rig/wire/modbus_master.h"
+#include "rig/runtime/clock.h"
 #include "rig/runtime/node.h"
 #include "rig/wire/serial_port.h"
 
@@ -32,7 +33,15 @@ struct WiredBoardOptions {
     std::optional<modbus::TcpMasterOptions> modbus_tcp;
     std::chrono::milliseconds poll_period{10};   // board inputs read at 100 Hz, like the DDS devices
     int modbus_retries = 2;                      // a lost frame is retried before it counts as a failure
+    // A board that answers nothing for this long is lost (the run ends); until
+    // then an exchange that failed its retries is a lost poll. 1 s: the rig's
+    // default comms-loss fail-safe (board.failsafe_timeout_s), by which the
+    // outputs are already de-energised.
+    std::chrono::milliseconds modbus_lost_after{1000};
 };
+
+// The Modbus RTU master's waits for a line at `baud` (the reasons are in the .cpp).
+modbus::MasterTimeouts rtu_master_timeouts(int baud);
 
 class WiredBoardController final : public Node {
 public:
@@ -74,6 +83,15 @@ private:
     TimeNs poll_period_ns_;
     TimeNs next_poll_ns_ = 0;
     std::uint64_t retries_used_ = 0;
+    // What the retries were for, and the longest wall time one failed attempt
+    // held the loop (a timeout waits for the master's timeouts), for the
+    // summary at shutdown.
+    std::uint64_t timeouts_retried_ = 0;
+    std::uint64_t bad_responses_retried_ = 0;
+    TimeNs longest_failed_attempt_ns_ = 0;
+    std::uint64_t exchanges_lost_ = 0;   // steps whose Modbus exchange failed after its retries
+    TimeNs last_exchange_ns_ = 0;        // the last step whose exchanges all succeeded
+    RealtimeClock attempt_clock_;
 };
 
 }  // namespace rig::controller
