@@ -6,6 +6,29 @@
 
 namespace rig::controller {
 
+std::vector<std::string> take_nmea_lines(std::string& buffer) {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t line_end = buffer.find('\n', start);
+        if (line_end == std::string::npos) break;
+        // NMEA 0183: '$' (or '!') starts a sentence. One inside the line means
+        // the sentence before it was cut off (a receiver that stopped writing
+        // mid-sentence): that fragment is a line of its own (the parser
+        // rejects and counts it), so the whole sentence after it is not lost with it.
+        std::size_t next = buffer.find_first_of("$!", start + 1);
+        while (next != std::string::npos && next < line_end) {
+            lines.push_back(buffer.substr(start, next - start));
+            start = next;
+            next = buffer.find_first_of("$!", start + 1);
+        }
+        lines.push_back(buffer.substr(start, line_end + 1 - start));
+        start = line_end + 1;
+    }
+    buffer.erase(0, start);
+    return lines;
+}
+
 modbus::MasterTimeouts rtu_master_timeouts(int baud) {
     // libmodbus's own defaults (0.5 s response, 0.5 s between bytes) are for a
     // line of unknown speed. This loop runs at 100 Hz and times the valve's
@@ -73,11 +96,7 @@ void WiredBoardController::read_nmea(TimeNs now_ns) {
         if (chunk.empty()) break;
         nmea_buffer_ += chunk;
     }
-    std::size_t line_end;
-    while ((line_end = nmea_buffer_.find('\n')) != std::string::npos) {
-        firmware_.on_nmea_sentence(nmea_buffer_.substr(0, line_end + 1), now_ns);
-        nmea_buffer_.erase(0, line_end + 1);
-    }
+    for (const std::string& line : take_nmea_lines(nmea_buffer_)) firmware_.on_nmea_sentence(line, now_ns);
     // A line longer than any NMEA sentence is noise on the wire: drop it (the
     // parser would reject it anyway) rather than grow without bound.
     if (nmea_buffer_.size() > 4096) {

@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
@@ -39,6 +40,11 @@ struct WiredBoardOptions {
     // outputs are already de-energised.
     std::chrono::milliseconds modbus_lost_after{1000};
 };
+
+// Complete lines taken from the front of what the NMEA UART received (the
+// rest, a line still arriving, stays in `buffer`). A '$' or '!' inside a line
+// starts a new one: the fragment before it is a line of its own.
+std::vector<std::string> take_nmea_lines(std::string& buffer);
 
 // The Modbus RTU master's waits for a line at `baud` (the reasons are in the .cpp).
 modbus::MasterTimeouts rtu_master_timeouts(int baud);

@@ -22,6 +22,7 @@
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
+#include "controller/wired_board_controller.h"
 #include "emulators/wire_faults.h"
 #include "rig/nmea/nmea_encoder.h"
 #include "rig/nmea/nmea_parser.h"
@@ -231,6 +232,29 @@ TEST(ControllerUnderWireFaults, CountsBadSentencesAndNeverTakesAPositionFromOne)
         EXPECT_EQ(*stored, *reference) << damage.name;
         EXPECT_EQ(rejected, 1u) << damage.name;
     }
+}
+
+// On the serial line a truncated sentence has no CR LF: the next sentence's
+// '$' follows its fragment at once. The wired controller's line framing
+// starts a new line there, so the fragment alone is rejected and the whole
+// sentence after it is used.
+TEST(ControllerUnderWireFaults, SerialFramingStartsANewLineAtEveryDollar) {
+    const auto fix = fix_at(7200.0, 40.18, 116.44);
+    const std::string gga = rig::nmea::encode_gga("GP", fix);
+    const std::string rmc = rig::nmea::encode_rmc("GP", fix);
+    NmeaWireFaults cut(NmeaWireFaultRates{0.0, 0.0, 100.0}, 2);
+    const std::string fragment = cut.apply(gga);
+    std::string uart = fragment + rmc + gga.substr(0, 20);  // the last still arriving
+    const std::vector<std::string> lines = rig::controller::take_nmea_lines(uart);
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_EQ(lines[0], fragment);
+    EXPECT_EQ(lines[1], rmc);
+    EXPECT_EQ(uart, gga.substr(0, 20));
+    EXPECT_FALSE(rig::nmea::parse_sentence(lines[0]).ok());
+    EXPECT_TRUE(rig::nmea::parse_sentence(lines[1]).ok());
+    uart += gga.substr(20);
+    EXPECT_EQ(rig::controller::take_nmea_lines(uart), std::vector<std::string>{gga});
+    EXPECT_TRUE(uart.empty());
 }
 
 // ---------------------------------------------------------------- Modbus RTU line noise
