@@ -57,7 +57,8 @@ std::string summary_line(const modbus::ModbusSlaveStatistics& stats) {
            " illegal function, " + std::to_string(stats.illegal_data_address) + " illegal data address, " +
            std::to_string(stats.illegal_data_value) + " illegal data value; dropped: " +
            std::to_string(stats.malformed_frames) + " malformed, " + std::to_string(stats.bad_crc_frames) +
-           " bad CRC, " + std::to_string(stats.other_slave_frames) + " for other slaves";
+           " bad CRC, " + std::to_string(stats.other_slave_frames) + " for other slaves; fail-safe trips: " +
+           std::to_string(stats.failsafe_trips);
 }
 
 std::atomic<bool> g_stop_signalled{false};
@@ -98,6 +99,12 @@ std::string modbus_serve_options_problem(const ModbusServeOptions& options) {
         return "--boom-height-adc must be 0.." + std::to_string(io::kAdcFullScale);
     }
     if (!(finite_at_least(options.update_hz, 1.0) && options.update_hz <= 1000.0)) return "--update-hz must be 1..1000";
+    // Up to an hour: beyond it a watchdog protects nothing; below 10 ms it trips between two polls of any master.
+    if (!(std::isfinite(options.failsafe_timeout_s) &&
+          (options.failsafe_timeout_s == 0.0 || (options.failsafe_timeout_s >= 0.01 && options.failsafe_timeout_s <= 3600.0)))) {
+        return "--failsafe-timeout-s must be 0 (off) or 0.01..3600";
+    }
+    if (options.failsafe != "safe" && options.failsafe != "hold") return "--failsafe must be safe or hold";
     if (options.rtu_device.empty()) {
         try {
             modbus::parse_tcp_endpoint(options.tcp);
@@ -145,6 +152,12 @@ CLI::App* add_modbus_serve_subcommand(CLI::App& modbus, ModbusServeOptions& opti
     serve->add_flag("--spray-switch", options.spray_switch, "spray switch on");
     serve->add_flag("--breakpoint-button", options.breakpoint_button, "breakpoint button held pressed");
     serve->add_option("--update-hz", options.update_hz, "how often the served counts advance")->capture_default_str();
+    serve->add_option("--failsafe-timeout-s", options.failsafe_timeout_s,
+                      "comms-loss watchdog: this long after the last valid request the coils go to --failsafe (0 = off)")
+        ->capture_default_str();
+    serve->add_option("--failsafe", options.failsafe,
+                      "what the watchdog does: safe (every coil de-energised) or hold (only counted)")
+        ->capture_default_str();
     return serve;
 }
 
@@ -169,6 +182,9 @@ int serve_modbus(const ModbusServeOptions& options, std::ostream& out, std::ostr
     };
     callbacks.on_problem = [&](const std::string& line) { print(err, "rig modbus serve: " + line); };
 
+    modbus::CommsFailsafe failsafe;
+    failsafe.timeout = std::chrono::milliseconds(std::llround(options.failsafe_timeout_s * 1000.0));
+    failsafe.mode = options.failsafe == "hold" ? modbus::FailsafeMode::hold : modbus::FailsafeMode::safe;
     std::optional<modbus::ModbusSlave> slave;
     try {
         if (options.rtu_device.empty()) {
@@ -177,6 +193,7 @@ int serve_modbus(const ModbusServeOptions& options, std::ostream& out, std::ostr
             tcp.bind_address = endpoint.address;
             tcp.port = endpoint.port;
             tcp.allow_non_loopback = options.allow_non_loopback;
+            tcp.failsafe = failsafe;
             slave.emplace(tcp, callbacks);
         } else {
             modbus::RtuSlaveOptions rtu;
@@ -186,6 +203,7 @@ int serve_modbus(const ModbusServeOptions& options, std::ostream& out, std::ostr
             rtu.line.data_bits = options.data_bits;
             rtu.line.stop_bits = options.stop_bits;
             rtu.slave_id = static_cast<std::uint8_t>(options.slave_id);
+            rtu.failsafe = failsafe;
             slave.emplace(rtu, callbacks);
         }
         slave->set_device_signals(synthetic_device_signals(options, 0.0));
@@ -197,8 +215,12 @@ int serve_modbus(const ModbusServeOptions& options, std::ostream& out, std::ostr
         return 1;
     }
 
+    const std::string watchdog = failsafe.timeout.count() == 0
+                                     ? "no comms-loss fail-safe"
+                                     : "comms-loss fail-safe " + std::string(modbus::to_string(failsafe.mode)) +
+                                           " after " + std::to_string(failsafe.timeout.count()) + " ms";
     print(out, "rig modbus serve: serving register map v" + std::to_string(modbus::kRegisterMapVersion) + " on " +
-                   slave->endpoint() + "; Ctrl-C stops");
+                   slave->endpoint() + "; " + watchdog + "; Ctrl-C stops");
     const TimeNs period_ns = static_cast<TimeNs>(1e9 / options.update_hz);
     TimeNs next_update_ns = 0;
     int exit_code = 0;

@@ -9,6 +9,7 @@
 //
 //   rig modbus serve --tcp 127.0.0.1:1502 --speed-km-h 6 --flow-l-min 20
 //   rig modbus serve --rtu /dev/ttyUSB0 --baud 115200 --parity N --slave-id 1
+//   rig modbus serve --tcp 127.0.0.1:1502 --failsafe-timeout-s 1 --failsafe safe
 #include <atomic>
 #include <iosfwd>
 #include <string>
@@ -43,6 +44,12 @@ struct ModbusServeOptions {
     bool spray_switch = false;
     bool breakpoint_button = false;
     double update_hz = 100.0;  // how often the served counts are refreshed
+
+    // The comms-loss watchdog (docs/modbus-register-map.md "Board timeouts"):
+    // off by default, since a person with mbpoll polls when they like; a board
+    // left on the bench overnight gets `--failsafe-timeout-s 1`.
+    double failsafe_timeout_s = 0.0;  // s after the last valid request; 0 = off
+    std::string failsafe = "safe";    // safe (every coil de-energised) | hold (counted only)
 };
 
 // The synthetic inputs `elapsed_s` after the start: cumulative wheel encoder

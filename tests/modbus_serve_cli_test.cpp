@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -83,6 +84,14 @@ TEST(ModbusServeSynthetic, OptionProblemsNameTheOption) {
     options.rtu_device = "/dev/ttyUSB0";
     options.parity = "X";
     EXPECT_NE(modbus_serve_options_problem(options).find("--parity"), std::string::npos);
+    options = {};
+    options.failsafe_timeout_s = 0.001;  // shorter than any master's poll period
+    EXPECT_EQ(modbus_serve_options_problem(options), "--failsafe-timeout-s must be 0 (off) or 0.01..3600");
+    options = {};
+    options.failsafe_timeout_s = 1.0;
+    EXPECT_EQ(modbus_serve_options_problem(options), "");
+    options.failsafe = "latch";
+    EXPECT_EQ(modbus_serve_options_problem(options), "--failsafe must be safe or hold");
 }
 
 // The running command, its log, and a way to wait for a line in it.
@@ -95,6 +104,14 @@ public:
     }
     std::filesystem::path log_path() const { return dir_ / "serve.log"; }
     std::string log() const { return read_file(log_path()); }
+    // The port it chose for --tcp 127.0.0.1:0, from its first line.
+    std::optional<std::uint16_t> tcp_port() const {
+        const std::string text = log();
+        const std::string marker = "on tcp 127.0.0.1:";
+        const auto at = text.find(marker);
+        if (at == std::string::npos) return std::nullopt;
+        return static_cast<std::uint16_t>(std::stoi(text.substr(at + marker.size())));
+    }
     bool wait_for(const std::string& text, std::size_t count = 1) const {
         return mt::eventually([&] { return lines_containing(log(), text).size() >= count; }, 20s);
     }
@@ -114,12 +131,10 @@ TEST(ModbusServeCommand, ServesTcpPrintsEveryChangeAndStopsOnSigint) {
                                      "--pulses-per-rev", "1000", "--flow-l-min", "20", "--pulses-per-l", "90",
                                      "--pump-flow-adc", "1000", "--spray-switch"});
     ASSERT_TRUE(serve.wait_for("serving register map v" + std::to_string(rig::modbus::kRegisterMapVersion) + " on tcp 127.0.0.1:")) << serve.log();
-    const std::string log = serve.log();
-    const std::string marker = "on tcp 127.0.0.1:";
-    const auto port_at = log.find(marker);
-    ASSERT_NE(port_at, std::string::npos) << log;
+    const std::optional<std::uint16_t> port = serve.tcp_port();
+    ASSERT_TRUE(port) << serve.log();
     modbus::TcpMasterOptions options;
-    options.slave.port = static_cast<std::uint16_t>(std::stoi(log.substr(port_at + marker.size())));
+    options.slave.port = *port;
     modbus::ModbusMaster master(options, {5000ms, 2000ms});
 
     const io::DeviceSignals first = master.read_device_signals();
@@ -163,6 +178,35 @@ TEST(ModbusServeCommand, ServesTcpPrintsEveryChangeAndStopsOnSigint) {
               std::string::npos)
         << indicator_lines[0];
     EXPECT_NE(final_log.find("rig modbus serve: stopped; answered"), std::string::npos) << final_log;
+}
+
+// A board left on the bench that stops polling: with --failsafe-timeout-s the
+// coils are de-energised (safe), the trip is printed and counted, and they stay
+// so until the master writes them again.
+TEST(ModbusServeCommand, TheCommsLossFailsafeDeEnergisesTheCoilsOfAQuietMaster) {
+    ServeProcess serve("serve-failsafe", {"--tcp", "127.0.0.1:0", "--failsafe-timeout-s", "0.2", "--failsafe", "safe"});
+    ASSERT_TRUE(serve.wait_for("; comms-loss fail-safe safe after 200 ms; Ctrl-C stops")) << serve.log();
+    const std::optional<std::uint16_t> port = serve.tcp_port();
+    ASSERT_TRUE(port) << serve.log();
+    modbus::TcpMasterOptions options;
+    options.slave.port = *port;
+    modbus::ModbusMaster master(options, {5000ms, 2000ms});
+
+    io::ActuatorCommands commands;
+    commands.ball_valve_forward = true;
+    commands.section_valves_open = 0b0000'0111;
+    master.write_actuator_commands(commands);
+    // The master goes quiet; the watchdog trips 200 ms after its last request.
+    ASSERT_TRUE(serve.wait_for("no valid request for 200 ms: comms-loss fail-safe (safe)")) << serve.log();
+    const io::ActuatorCommands after = master.read_actuator_commands();
+    EXPECT_FALSE(after.ball_valve_forward);
+    EXPECT_EQ(after.section_valves_open, 0);
+    // Writing again restores them.
+    master.write_actuator_commands(commands);
+    EXPECT_EQ(master.read_actuator_commands().section_valves_open, 0b0000'0111);
+    EXPECT_EQ(serve.interrupt(), "process exited with status 0");
+    EXPECT_NE(serve.log().find("fail-safe trips: "), std::string::npos) << serve.log();
+    EXPECT_EQ(lines_containing(serve.log(), "fail-safe trips: 0").size(), 0u) << serve.log();
 }
 
 TEST(ModbusServeCommand, ServesRtuWithTheGivenLineSettings) {

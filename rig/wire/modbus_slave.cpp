@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "rig/runtime/clock.h"
+#include "rig/runtime/realtime.h"
 
 namespace rig::modbus {
 namespace {
@@ -226,6 +227,11 @@ public:
     void set_response_damage(ResponseDamage damage) {
         std::lock_guard lock(mutex_);
         response_damage_ = std::move(damage);
+    }
+
+    std::string raise_to_realtime(int priority) {
+        std::lock_guard stop_lock(stop_mutex_);
+        return raise_thread_to_realtime(thread_, priority);
     }
 
     void stop() {
@@ -801,5 +807,6 @@ bool ModbusSlave::failsafe_active() const { return impl_->failsafe_active(); }
 std::optional<std::string> ModbusSlave::server_failure() const { return impl_->server_failure(); }
 void ModbusSlave::set_response_damage(ResponseDamage damage) { impl_->set_response_damage(std::move(damage)); }
 void ModbusSlave::stop() { impl_->stop(); }
+std::string ModbusSlave::raise_to_realtime(int priority) { return impl_->raise_to_realtime(priority); }
 
 }  // namespace rig::modbus

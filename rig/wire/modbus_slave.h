@@ -161,6 +161,11 @@ public:
     using ResponseDamage = std::function<std::vector<std::uint8_t>(std::vector<std::uint8_t>)>;
     void set_response_damage(ResponseDamage damage);
 
+    // SCHED_FIFO at `priority` for the serving thread (real-time runs: the
+    // master's answers must not wait for the machine's other work). "" when
+    // granted, else why not.
+    std::string raise_to_realtime(int priority);
+
     // Stops serving and closes the port; bounded time, idempotent. Must not be
     // called from a callback.
     void stop();
