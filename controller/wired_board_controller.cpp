@@ -1,7 +1,6 @@
 #include "controller/wired_board_controller.h"
 
 #include <algorithm>
-#include <cmath>
 #include <iostream>
 
 namespace rig::controller {
@@ -29,20 +28,21 @@ std::vector<std::string> take_nmea_lines(std::string& buffer) {
     return lines;
 }
 
-modbus::MasterTimeouts rtu_master_timeouts(int baud) {
-    // libmodbus's own defaults (0.5 s response, 0.5 s between bytes) are for a
-    // line of unknown speed. This loop runs at 100 Hz and times the valve's
-    // relay pulses, and every wait here holds it: a response whose first byte
-    // was lost to noise left it waiting the whole byte timeout for bytes that
-    // never came (0.53 s, cases/wire-faults/modbus-line-noise-wired-rtu.yaml),
-    // which lengthened relay pulses and broke the flow. So the waits are what
-    // the line needs: 20 ms between bytes, since USB-serial adapters deliver
-    // a frame in chunks up to ~16 ms apart; and for the first byte, a whole
-    // 256-byte ADU at the baud (10 bits a byte) plus 100 ms for the slave's
-    // turnaround on a loaded machine (only a response lost whole waits for it).
-    constexpr double kMaxAduBytes = 256.0;
-    const auto frame_ms = static_cast<long>(std::ceil(kMaxAduBytes * 10.0 * 1000.0 / std::max(baud, 1)));
-    return modbus::MasterTimeouts{std::chrono::milliseconds(100 + frame_ms), std::chrono::milliseconds(20)};
+modbus::MasterTimeouts rtu_master_timeouts() {
+    // libmodbus's own default between bytes (0.5 s) is for a line of unknown
+    // speed. This loop runs at 100 Hz and times the valve's relay pulses, and
+    // every wait here holds it: when noise made a response look longer than
+    // it was (a burst in front of it), the master waited the whole byte
+    // timeout for bytes that never came (0.53 s,
+    // cases/wire-faults/modbus-line-noise-wired-rtu.yaml), which stretched the
+    // relay pulses and broke the flow. 20 ms: USB-serial adapters deliver a
+    // frame in chunks up to ~16 ms apart. The wait for a response's first byte
+    // stays the master's 1 s: only a response lost whole waits for it, and
+    // shorter, a slave answering late on a loaded machine turned each late
+    // answer into a retry that could read it in place of its own.
+    modbus::MasterTimeouts timeouts;
+    timeouts.byte_timeout = std::chrono::milliseconds(20);
+    return timeouts;
 }
 
 WiredBoardController::WiredBoardController(std::string node_name, ControllerConfig config,
@@ -56,7 +56,7 @@ void WiredBoardController::configure(DdsContext& /*dds*/) {
     if (options_.nmea_port.empty()) throw std::runtime_error("wired mode needs the NMEA serial port");
     nmea_port_ = std::make_unique<SerialPort>(options_.nmea_port, options_.nmea_line);
     if (options_.modbus_rtu) {
-        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_rtu, rtu_master_timeouts(options_.modbus_rtu->line.baud));
+        board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_rtu, rtu_master_timeouts());
     } else if (options_.modbus_tcp) {
         board_ = std::make_unique<modbus::ModbusMaster>(*options_.modbus_tcp);
     } else {

@@ -46,8 +46,8 @@ struct WiredBoardOptions {
 // starts a new one: the fragment before it is a line of its own.
 std::vector<std::string> take_nmea_lines(std::string& buffer);
 
-// The Modbus RTU master's waits for a line at `baud` (the reasons are in the .cpp).
-modbus::MasterTimeouts rtu_master_timeouts(int baud);
+// The Modbus RTU master's waits (the reasons are in the .cpp).
+modbus::MasterTimeouts rtu_master_timeouts();
 
 class WiredBoardController final : public Node {
 public:
