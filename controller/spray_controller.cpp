@@ -58,12 +58,18 @@ void SprayController::on_nmea_sentence(const std::string& line, TimeNs now_ns) {
         } else {
             last_fix_.reset();
         }
+        last_fix_utc_ = gga->utc_time;
         return;
     }
     if (const auto* rmc = std::get_if<nmea::RmcData>(&sentence.data)) {
         if (rmc->course_true_deg) last_course_deg_ = *rmc->course_true_deg;
-        // The G970II sends GGA then RMC for one epoch: the epoch is complete here.
-        if (last_fix_ && rmc->status == nmea::DataStatus::valid) handle_fix_complete(now_ns);
+        // The G970II sends GGA then RMC for one epoch: the epoch is complete
+        // here, if this RMC is the GGA's own. When the epoch's GGA was lost on
+        // the wire (rejected), the GGA before it is an epoch old: acting on it
+        // now would take an old position for a new one, so the epoch is skipped.
+        if (last_fix_ && rmc->status == nmea::DataStatus::valid && rmc->utc_time == last_fix_utc_) {
+            handle_fix_complete(now_ns);
+        }
     }
 }
 

@@ -46,6 +46,7 @@
 #include "controller/valve_driver.h"
 #include "controllerPubSubTypes.h"
 #include "rig/runtime/clock.h"
+#include "rig/nmea/nmea_parser.h"
 #include "rig/runtime/io_image.h"
 
 namespace rig::controller {
@@ -126,6 +127,10 @@ private:
 
     // GNSS, assembled from GGA (position, quality) and RMC (course).
     std::optional<FixInput> last_fix_;
+    // The UTC time of the GGA that gave last_fix_: an RMC completes the epoch
+    // only when it carries the same time (a lost GGA must not leave the one
+    // before it to be taken as this epoch's fix).
+    std::optional<nmea::UtcTime> last_fix_utc_;
     std::optional<double> last_course_deg_;  // kept while standing (RMC course is empty then)
     TimeNs last_fix_complete_ns_ = 0;        // when the last GGA+RMC epoch completed
     TimeNs next_stale_fix_ns_ = 0;           // the stale-fix fault's next re-feed

@@ -15,10 +15,12 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "controller/controller_config.h"
 #include "controller/spray_controller.h"
 #include "rig/wire/modbus_master.h"
+#include "rig/runtime/clock.h"
 #include "rig/runtime/node.h"
 #include "rig/wire/serial_port.h"
 
@@ -32,7 +34,20 @@ struct WiredBoardOptions {
     std::optional<modbus::TcpMasterOptions> modbus_tcp;
     std::chrono::milliseconds poll_period{10};   // board inputs read at 100 Hz, like the DDS devices
     int modbus_retries = 2;                      // a lost frame is retried before it counts as a failure
+    // A board that answers nothing for this long is lost (the run ends); until
+    // then an exchange that failed its retries is a lost poll. 1 s: the rig's
+    // default comms-loss fail-safe (board.failsafe_timeout_s), by which the
+    // outputs are already de-energised.
+    std::chrono::milliseconds modbus_lost_after{1000};
 };
+
+// Complete lines taken from the front of what the NMEA UART received (the
+// rest, a line still arriving, stays in `buffer`). A '$' or '!' inside a line
+// starts a new one: the fragment before it is a line of its own.
+std::vector<std::string> take_nmea_lines(std::string& buffer);
+
+// The Modbus RTU master's waits (the reasons are in the .cpp).
+modbus::MasterTimeouts rtu_master_timeouts();
 
 class WiredBoardController final : public Node {
 public:
@@ -74,6 +89,15 @@ private:
     TimeNs poll_period_ns_;
     TimeNs next_poll_ns_ = 0;
     std::uint64_t retries_used_ = 0;
+    // What the retries were for, and the longest wall time one failed attempt
+    // held the loop (a timeout waits for the master's timeouts), for the
+    // summary at shutdown.
+    std::uint64_t timeouts_retried_ = 0;
+    std::uint64_t bad_responses_retried_ = 0;
+    TimeNs longest_failed_attempt_ns_ = 0;
+    std::uint64_t exchanges_lost_ = 0;   // steps whose Modbus exchange failed after its retries
+    TimeNs last_exchange_ns_ = 0;        // the last step whose exchanges all succeeded
+    RealtimeClock attempt_clock_;
 };
 
 }  // namespace rig::controller

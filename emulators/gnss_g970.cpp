@@ -31,7 +31,8 @@ int gga_quality(GnssFixKind kind) {
 }
 
 GnssG970::GnssG970(const Plant& plant, G970Params params)
-    : plant_(plant), params_(std::move(params)), noise_(params_.seed, "gnss_g970") {}
+    : plant_(plant), params_(std::move(params)), noise_(params_.seed, "gnss_g970"),
+      wire_faults_(params_.wire_faults, params_.seed) {}
 
 void GnssG970::configure(DdsContext& dds) {
     nmea_writer_ = std::make_unique<Writer<msg::NmeaSentence>>(dds, topics::kGnssNmea);
@@ -98,8 +99,12 @@ TimeNs GnssG970::step(TimeNs now_ns) {
         if (auto fix = solve_epoch(epoch_ns)) {
             for (const std::string& sentence :
                  {nmea::encode_gga(params_.talker, *fix), nmea::encode_rmc(params_.talker, *fix)}) {
+                // The fix is solved and encoded as ever; only the bytes that
+                // leave the receiver are damaged (nothing at all: not sent).
+                const std::string bytes = wire_faults_.apply(sentence);
+                if (bytes.empty()) continue;
                 msg::NmeaSentence wire;
-                wire.sentence(sentence);
+                wire.sentence(bytes);
                 nmea_writer_->publish(wire);
             }
         }

@@ -9,6 +9,8 @@
 //   latency_s  epoch -> sentences on the wire
 //   dropouts   intervals with no sentences at all (signal lost, Table 4 run 8)
 //   degraded   intervals with a worse fix (RTK float / DGPS / autonomous) and noise
+//   wire_faults  byte loss, corrupt checksums, truncated sentences on the way
+//              out (emulators/wire_faults.h): only the bytes change, never the fix
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -18,6 +20,7 @@
 #include "rig/nmea/nmea_encoder.h"
 #include "emulators/plant.h"
 #include "emulators/seeded_random.h"
+#include "emulators/wire_faults.h"
 
 namespace rig::emulators {
 
@@ -44,6 +47,7 @@ struct G970Params {
     std::vector<GnssEpisode> degraded;
     int utc_year = 2023, utc_month = 7, utc_day = 15;
     double utc_start_seconds_of_day = 2 * 3600.0;
+    NmeaWireFaultRates wire_faults;  // all off by default
     std::uint64_t seed = 1;
 };
 
@@ -58,12 +62,16 @@ public:
     // Public so tests can check the error model without DDS.
     std::optional<nmea::GnssFix> solve_epoch(TimeNs epoch_ns);
 
+    // What the wire faults did so far (all zero when they are off).
+    const NmeaWireFaultCounts& wire_fault_counts() const { return wire_faults_.counts(); }
+
 private:
     TimeNs epoch_period_ns() const;
     std::string name_ = "gnss_g970";
     const Plant& plant_;
     G970Params params_;
     SeededRandom noise_;
+    NmeaWireFaults wire_faults_;
     std::int64_t next_epoch_index_ = 0;
     std::unique_ptr<Writer<msg::NmeaSentence>> nmea_writer_;
 };

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "harness/results_writer.h"
+#include "harness/wire_fault_report.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/wire/modbus_slave.h"
 
@@ -229,6 +230,7 @@ nlohmann::json board_io_report(const CaseSpec& spec, BenchWires& wires, const st
         {"silence_timeout_s", spec.board.silence_timeout_s},
         {"last_problem", stats.last_problem},
     };
+    if (wires.line_noise) report["line_noise"] = line_noise_json(*wires.line_noise);
     if (attachment) report["attach"] = {{"waited_s", attachment->waited_s}, {"seen", attachment->seen}};
     return report;
 }

@@ -27,6 +27,13 @@ std::string failsafe_text(const nlohmann::json& board_io) {
     return text;
 }
 
+// "159 of 8286 responses corrupted, 91 noise bursts (390 bytes)": what the case's line noise did.
+std::string line_noise_counts(const nlohmann::json& noise) {
+    return count_of(noise, "responses_corrupted") + " of " + count_of(noise, "responses") +
+           " responses corrupted, " + count_of(noise, "noise_bursts") + " noise bursts (" +
+           count_of(noise, "noise_bytes") + " bytes)";
+}
+
 }  // namespace
 
 std::string board_io_summary(const nlohmann::json& board_io) {
@@ -35,7 +42,8 @@ std::string board_io_summary(const nlohmann::json& board_io) {
            count_of(board_io, "broadcast") + " broadcast, " + count_of(board_io, "master_writes") +
            " writes); refused: " + counts_text(board_io.value("refused", nlohmann::json::object())) +
            "; dropped: " + counts_text(board_io.value("dropped", nlohmann::json::object())) +
-           "; fail-safe: " + failsafe_text(board_io);
+           "; fail-safe: " + failsafe_text(board_io) +
+           (board_io.contains("line_noise") ? "; line noise: " + line_noise_counts(board_io.at("line_noise")) : "");
 }
 
 std::vector<std::pair<std::string, std::string>> board_io_rows(const nlohmann::json& board_io) {
@@ -50,6 +58,7 @@ std::vector<std::pair<std::string, std::string>> board_io_rows(const nlohmann::j
         for (const auto& [kind, value] : counts.items()) rows.emplace_back(std::string(block) + ": " + kind, value.dump());
     }
     rows.emplace_back("fail-safe", failsafe_text(board_io));
+    if (board_io.contains("line_noise")) rows.emplace_back("line noise (injected)", line_noise_counts(board_io.at("line_noise")));
     if (board_io.contains("attach")) {
         const nlohmann::json& attach = board_io.at("attach");
         std::string seen;

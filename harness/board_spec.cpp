@@ -22,6 +22,11 @@ BoardSpec read_board_spec(const YamlSection& section) {
                                            "line takes tens of ms)");
     }
     board.failsafe = section.optional_enum<modbus::FailsafeMode>("failsafe", kFailsafeModes, board.failsafe);
+    // Percentages of responses: at 100 every response is damaged.
+    const YamlSection noise = section.section("line_noise");
+    board.line_noise.corrupt_response_pct =
+        noise.optional_in_range<double>("corrupt_response_pct", 0.0, Bounds::closed(0, 100));
+    board.line_noise.noise_burst_pct = noise.optional_in_range<double>("noise_burst_pct", 0.0, Bounds::closed(0, 100));
     return board;
 }
 

@@ -8,6 +8,9 @@
 //     silence_timeout_s: 2     # a Modbus master quiet this long fails the case (board_silent)
 //     failsafe_timeout_s: 1    # the rig's I/O watchdog: coils go to `failsafe` this long after the last request
 //     failsafe: safe           # safe (every coil de-energised) or hold
+//     line_noise:              # Modbus RTU only: the line damages the slave's responses (emulators/wire_faults.h)
+//       corrupt_response_pct: 2  #   of responses with a byte hit (the master sees a bad CRC)
+//       noise_burst_pct: 1       #   of responses followed by 1-8 random bytes on the line
 #include "rig/config/yaml_fields.h"
 #include "rig/wire/modbus_protocol.h"
 
@@ -28,6 +31,13 @@ struct BoardSpec {
     // is already safe when the case fails on the silence.
     double failsafe_timeout_s = 1.0;
     modbus::FailsafeMode failsafe = modbus::FailsafeMode::safe;
+    // Noise on the RTU line, percent of the slave's responses, each [0, 100],
+    // 0 = off (the default): drawn from the case seed on its own stream.
+    struct LineNoise {
+        double corrupt_response_pct = 0.0;
+        double noise_burst_pct = 0.0;
+        bool any() const { return corrupt_response_pct > 0.0 || noise_burst_pct > 0.0; }
+    } line_noise;
 };
 
 BoardSpec read_board_spec(const YamlSection& section);

@@ -25,6 +25,7 @@
 #include "harness/case_world.h"
 #include "harness/run_interrupt.h"
 #include "harness/trace_recorder.h"
+#include "harness/wire_fault_report.h"
 #include "idl/topics.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/runtime/realtime.h"
@@ -449,6 +450,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.set_vehicle_truth_probe([&world](TimeNs t) { return world.plant.truth_at(t); });
         // Nodes hold DDS writers, so they are declared after (and destroyed before) the context.
         LocalNodes nodes(spec, world, circuit, seed, session.wires());
+        install_line_noise(spec, seed, session.wires());  // board.line_noise, if any
 
         TimeNs now_ns = 0;
         RunFacts facts;
@@ -469,6 +471,10 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.file().record_deposition(circuit.deposition());
         trace.file().record_landing_edges(circuit.landing_edges());
         facts.board_io = board_io_report(spec, session.wires(), facts.board_attachment);
+        if (spec.gnss.wire_faults.any()) {
+            trace.file().set_meta(kGnssWireFaultsMeta,
+                                  gnss_wire_fault_json(spec.gnss.wire_faults, nodes.gnss.wire_fault_counts()).dump());
+        }
         trace.file().set_meta("run", run_facts_json(facts, wall.elapsed_s()).dump());
         trace.file().finish(outcome);
     } catch (const std::exception& error) {

@@ -12,6 +12,7 @@
 
 #include <functional>
 
+#include "emulators/wire_faults.h"
 #include "harness/case_spec.h"
 #include "harness/trace_file.h"
 #include "harness/in_process_controller.h"
@@ -36,6 +37,8 @@ struct BenchWires {
     std::string board_io_far_end;     // what the controller opens: a tty path or ADDRESS:PORT
     std::vector<std::string> controller_args;
     std::string description = "dds";
+    // The Modbus RTU line's noise when the case has some (harness/wire_fault_report.h).
+    std::shared_ptr<emulators::RtuLineNoise> line_noise;
 };
 // Opens what spec.wiring asks for; throws std::runtime_error naming the port.
 BenchWires open_bench_wires(const CaseSpec& spec);

@@ -242,6 +242,12 @@ GnssSpec read_gnss(const YamlSection& section) {
         degraded.sigma_m = item.required_in_range<double>("sigma_m", Bounds::closed(0, 100));
         gnss.degraded.push_back(degraded);
     }
+    // Percentages of bytes or sentences: 100 is a receiver whose every output is damaged.
+    const YamlSection faults = section.section("wire_faults");
+    gnss.wire_faults.byte_loss_pct = faults.optional_in_range<double>("byte_loss_pct", 0.0, Bounds::closed(0, 100));
+    gnss.wire_faults.corrupt_checksum_pct =
+        faults.optional_in_range<double>("corrupt_checksum_pct", 0.0, Bounds::closed(0, 100));
+    gnss.wire_faults.truncate_pct = faults.optional_in_range<double>("truncate_pct", 0.0, Bounds::closed(0, 100));
     return gnss;
 }
 
@@ -522,6 +528,10 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     }
     if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
         root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
+    }
+    if (spec.board.line_noise.any() && spec.wiring.board_io != BoardIoWireKind::modbus_rtu) {
+        root.section("board").fail("line_noise", "line noise is injected on a Modbus RTU line: needs `wiring: { "
+                                                 "board_io: modbus_rtu }`");
     }
     for (const char* section : {"realtime", "rig_faults"}) {
         if (root.has(section) && spec.mode != RunMode::realtime) {

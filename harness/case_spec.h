@@ -128,6 +128,16 @@ struct GnssDegraded {
     SourceLocation for_location;
 };
 
+// Faults of the receiver's wire output (emulators/wire_faults.h), percent, each
+// [0, 100], 0 = off (the default): the fix is unchanged, only the bytes the
+// receiver sends are damaged. Drawn from the case seed on their own stream.
+struct GnssWireFaultsSpec {
+    double byte_loss_pct = 0.0;         // per byte: lost on the line (ArduPilot SIM_GPS_BYTELOSS)
+    double corrupt_checksum_pct = 0.0;  // per sentence: its checksum digits garbled
+    double truncate_pct = 0.0;          // per sentence: cut off before its checksum ends, no CR LF
+    bool any() const { return byte_loss_pct > 0.0 || corrupt_checksum_pct > 0.0 || truncate_pct > 0.0; }
+};
+
 struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
     double rate_hz = 5.0;      // [1, 20]; the G970II runs at 5 Hz
@@ -141,6 +151,7 @@ struct GnssSpec {
     GnssNoiseSpec noise;
     std::vector<GnssDropout> dropouts;  // may overlap each other; at most 1000
     std::vector<GnssDegraded> degraded;  // at most 1000
+    GnssWireFaultsSpec wire_faults;
 };
 
 struct EncoderSpec {

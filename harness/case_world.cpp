@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "emulators/seeded_random.h"
+#include "harness/wire_fault_report.h"
 
 namespace rig::harness {
 
@@ -119,6 +120,7 @@ emulators::G970Params gnss_params(const CaseSpec& spec, std::uint64_t seed, doub
     params.utc_start_seconds_of_day =
         std::chrono::duration<double>(spec.utc_start - std::chrono::sys_time<std::chrono::nanoseconds>(start_day))
             .count();
+    params.wire_faults = nmea_wire_fault_rates(spec.gnss.wire_faults);
     params.seed = seed;
     return params;
 }

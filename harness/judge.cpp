@@ -12,6 +12,7 @@
 #include "emulators/field_frame.h"
 #include "harness/boundary_judge.h"
 #include "harness/trace_file.h"
+#include "harness/wire_fault_report.h"
 #include "idl/topics.h"
 #include "rig/runtime/failure_kind.h"
 
@@ -111,7 +112,7 @@ const std::set<std::string>& judged_topics() {
     static const std::set<std::string> topics = {
         topics::kVehicleTruth,     topics::kHydraulicsTruth,  topics::kSectionValves,
         topics::kBreakpointEvent,  topics::kControllerStatus, topics::kMainFlowMeter,
-        topics::kVehicle2dTruth,   topics::kNozzlesTruth,
+        topics::kVehicle2dTruth,   topics::kNozzlesTruth,     topics::kGnssNmea,  // GNSS wire faults
     };
     return topics;
 }
@@ -549,6 +550,7 @@ CaseRun judge_trace(const RecordedTrace& trace) {
         }
         // Seed 001's boundary cases (harness/boundary_judge.h).
         if (plan.scenario == "boundary") metrics.merge(boundary_trace_metrics(trace, boundary_judging_plan_from_json(judging.at("boundary"))));
+        metrics.merge(gnss_wire_fault_metrics(trace));  // cases with gnss.wire_faults only
         result.metrics = metrics.values;
         result.not_measured = metrics.not_measured;
 

@@ -642,15 +642,15 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
         "gnss",       "gnss.noise",  "gnss.dropouts[0]",   "gnss.degraded[0]",       "encoder",
         "hydraulics", "hydraulics.valve", "hydraulics.flow_map", "flow_meter", "pump_sensor",
         "boom_height_sensor",        "deposition",         "static_flow", "wiring",   "timeouts",
-        "realtime",   "rig_faults"};
+        "realtime",   "rig_faults", "gnss.wire_faults", "board.line_noise"};
     const int ranged =
         expect_every_number_bounded(sections, [](const std::string& section, const std::string& key,
                                                  const std::string& value) {
             parse_case(minimal_with(section, key, value), "bounds.yaml");
         });
-    // The sweep found the keys, not an empty list: a case file has 81 numbers
+    // The sweep found the keys, not an empty list: a case file has 86 numbers
     // (a new one with a range changes this count; one without fails above).
-    EXPECT_EQ(ranged, 81);
+    EXPECT_EQ(ranged, 86);
     // Limits are data keys: their values are bounded too.
     for (const char* value : {"1e300", "-1e300"}) {
         EXPECT_THROW(parse_case(std::string(kMinimalCase) + "limits: { overlap_m: " + value + " }\n", "l.yaml"),
@@ -1036,6 +1036,64 @@ TEST(CaseSpec, BoardKeysParseWithDefaultsAndBounds) {
             EXPECT_NE(std::string(error.what()).find("board"), std::string::npos) << error.what();
         }
     }
+}
+
+// Wire faults (emulators/wire_faults.h): off unless written, percentages in [0, 100].
+TEST(CaseSpec, WireFaultsAreOffByDefaultAndReadAsWritten) {
+    const CaseSpec defaults = parse_case(std::string(kMinimalCase), "case.yaml");
+    EXPECT_FALSE(defaults.gnss.wire_faults.any());
+    EXPECT_FALSE(defaults.board.line_noise.any());
+    const CaseSpec set = parse_case(
+        std::string(kMinimalCase) +
+            "gnss: { wire_faults: { byte_loss_pct: 0.5, corrupt_checksum_pct: 15, truncate_pct: 25 } }\n",
+        "case.yaml");
+    EXPECT_EQ(set.gnss.wire_faults.byte_loss_pct, 0.5);
+    EXPECT_EQ(set.gnss.wire_faults.corrupt_checksum_pct, 15.0);
+    EXPECT_EQ(set.gnss.wire_faults.truncate_pct, 25.0);
+    const std::string wired = "mode: realtime\nwiring: { gnss: serial, board_io: modbus_rtu }\n";
+    const CaseSpec noisy = parse_case(
+        std::string(kMinimalCase) + wired + "board: { line_noise: { corrupt_response_pct: 2, noise_burst_pct: 1 } }\n",
+        "case.yaml");
+    EXPECT_EQ(noisy.board.line_noise.corrupt_response_pct, 2.0);
+    EXPECT_EQ(noisy.board.line_noise.noise_burst_pct, 1.0);
+}
+
+TEST(CaseSpec, WireFaultsOutsideTheirRangeOrWireAreRefusedAtTheirKey) {
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"gnss: { wire_faults: { byte_loss_pct: 101 } }\n", "gnss.wire_faults.byte_loss_pct"},
+        {"gnss: { wire_faults: { truncate_pct: -1 } }\n", "gnss.wire_faults.truncate_pct"},
+        {"gnss: { wire_faults: { bit_flip_pct: 1 } }\n", "gnss.wire_faults"},
+        // Line noise is injected on an RTU line: on DDS (or TCP) there is none to inject.
+        {"board: { line_noise: { corrupt_response_pct: 2 } }\n", "board.line_noise"},
+        {"mode: realtime\nwiring: { gnss: serial, board_io: modbus_tcp }\nboard: { line_noise: { noise_burst_pct: 1 } }\n",
+         "board.line_noise"},
+    };
+    for (const auto& [text, key] : bad) {
+        try {
+            parse_case(std::string(kMinimalCase) + text, "case.yaml");
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const ConfigError& error) {
+            EXPECT_TRUE(error.key_path().starts_with(key)) << error.what();
+        }
+    }
+}
+
+// Every case the repository ships (what `rig run cases` and scripts/demo run)
+// loads: a key renamed in the loader cannot leave a case behind.
+TEST(CaseSpec, EveryCaseInTheRepositoryLoads) {
+    const std::vector<std::filesystem::path> files = expand_case_paths({RIG_SOURCE_DIR "/cases"});
+    EXPECT_GT(files.size(), 50u);
+    bool wire_faults = false;
+    for (const std::filesystem::path& file : files) {
+        SCOPED_TRACE(file.string());
+        try {
+            const CaseSpec spec = load_case_file(file);
+            wire_faults = wire_faults || spec.gnss.wire_faults.any() || spec.board.line_noise.any();
+        } catch (const ConfigError& error) {
+            ADD_FAILURE() << error.what();
+        }
+    }
+    EXPECT_TRUE(wire_faults) << "cases/wire-faults/ is among them";
 }
 
 // `realtime:` (harness/realtime_spec.h): the bound on the rig's own lateness;

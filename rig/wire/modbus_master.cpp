@@ -1,6 +1,8 @@
 #include "rig/wire/modbus_master.h"
 
 #include <arpa/inet.h>
+#include <poll.h>
+#include <unistd.h>
 #include <modbus/modbus.h>
 
 #include <cerrno>
@@ -100,6 +102,28 @@ void ModbusMaster::connect() {
     connected_ = true;
 }
 
+void ModbusMaster::drain_serial_line() {
+    // The rest of a broken frame (the bytes after a hit one, a noise burst in
+    // front of a response) may still be arriving: a bare flush now would leave
+    // them to be read as the retry's response, and the retry would fail on the
+    // last request's leftovers. So: discard until the line has been quiet for
+    // kLineSettleSilence, then flush. Bounded: at most kMaxDrainReads reads.
+    // 20 ms: USB-serial adapters deliver a frame in chunks up to ~16 ms apart
+    // (the slave's frame_end_silence, rig/wire/modbus_slave.h, has the same reason).
+    constexpr int kLineSettleSilenceMs = 20;
+    constexpr int kMaxDrainReads = 64;
+    const int fd = modbus_get_socket(context_->handle);
+    for (int reads = 0; fd >= 0 && reads < kMaxDrainReads; ++reads) {
+        pollfd watch{fd, POLLIN, 0};
+        const int ready = ::poll(&watch, 1, kLineSettleSilenceMs);
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready <= 0 || (watch.revents & POLLIN) == 0) break;
+        std::uint8_t discard[256];
+        if (::read(fd, discard, sizeof discard) <= 0) break;
+    }
+    modbus_flush(context_->handle);
+}
+
 void ModbusMaster::fail(const std::string& operation, int error) {
     using Kind = ModbusMasterError::Kind;
     const std::string prefix = "Modbus master " + endpoint_ + ": " + operation + ": ";
@@ -117,7 +141,7 @@ void ModbusMaster::fail(const std::string& operation, int error) {
         modbus_close(context_->handle);
         connected_ = false;
     } else {
-        modbus_flush(context_->handle);
+        drain_serial_line();
     }
     if (error == ETIMEDOUT) {
         throw ModbusMasterError(Kind::timeout, endpoint_,

@@ -95,6 +95,8 @@ public:
 private:
     void connect();
     [[noreturn]] void fail(const std::string& operation, int error);
+    // RTU, after a bad or late response: waits for the line to fall quiet, then flushes.
+    void drain_serial_line();
     template <typename Call>
     int transact(const std::string& operation, int expected, Call call);
 

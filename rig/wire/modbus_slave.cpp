@@ -224,6 +224,11 @@ public:
         if (failsafe.timeout.count() < 0) throw std::invalid_argument("Modbus fail-safe timeout must be >= 0 ms (0 = off)");
     }
 
+    void set_response_damage(ResponseDamage damage) {
+        std::lock_guard lock(mutex_);
+        response_damage_ = std::move(damage);
+    }
+
     std::string raise_to_realtime(int priority) {
         std::lock_guard stop_lock(stop_mutex_);
         return raise_thread_to_realtime(thread_, priority);
@@ -695,7 +700,9 @@ private:
                 // The spec's 3.5 characters of silence after the request before answering
                 // (a half-duplex RS-485 master needs them to turn its line around).
                 clock_.sleep_until_ns(last_byte_ns + rtu_inter_frame_gap_ns(rtu_options_.line.baud));
-                write_serial(frame_rtu(rtu_options_.slave_id, response));
+                std::vector<std::uint8_t> frame = frame_rtu(rtu_options_.slave_id, response);
+                if (const ResponseDamage damage = response_damage(); damage) frame = damage(std::move(frame));
+                write_serial(frame);
                 return;
             }
             case Kind::bad_crc:
@@ -738,6 +745,11 @@ private:
                        std::to_string(rtu_options_.write_timeout.count()) + " ms)");
     }
 
+    ResponseDamage response_damage() const {
+        std::lock_guard lock(mutex_);
+        return response_damage_;
+    }
+
     // ---------------------------------------------------------------- state
 
     mutable std::mutex mutex_;  // guards image_, previous_*, stats_, failure_
@@ -750,6 +762,7 @@ private:
     std::optional<TimeNs> last_request_ns_;  // clock_ time of the last valid request
     bool failsafe_tripped_ = false;
     CommsFailsafe failsafe_;
+    ResponseDamage response_damage_;  // guarded by mutex_
 
     ModbusSlaveCallbacks callbacks_;
     std::string endpoint_;
@@ -792,6 +805,7 @@ ModbusSlaveStatistics ModbusSlave::statistics() const { return impl_->statistics
 std::optional<std::chrono::nanoseconds> ModbusSlave::since_last_request() const { return impl_->since_last_request(); }
 bool ModbusSlave::failsafe_active() const { return impl_->failsafe_active(); }
 std::optional<std::string> ModbusSlave::server_failure() const { return impl_->server_failure(); }
+void ModbusSlave::set_response_damage(ResponseDamage damage) { impl_->set_response_damage(std::move(damage)); }
 void ModbusSlave::stop() { impl_->stop(); }
 std::string ModbusSlave::raise_to_realtime(int priority) { return impl_->raise_to_realtime(priority); }
 

@@ -27,6 +27,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rig/runtime/io_image.h"
 #include "rig/wire/modbus_protocol.h"
@@ -152,6 +153,13 @@ public:
     // Set when the server thread ended on an unexpected error (it then serves
     // no more); the message says what. Never set in normal operation.
     std::optional<std::string> server_failure() const;
+
+    // RTU: what the line does to each response frame (address .. CRC) on its
+    // way to the master: the frame to write instead (a case's line noise,
+    // emulators/wire_faults.h). Called from the server thread, never
+    // concurrently with itself; must not throw. Empty = the frame as made.
+    using ResponseDamage = std::function<std::vector<std::uint8_t>(std::vector<std::uint8_t>)>;
+    void set_response_damage(ResponseDamage damage);
 
     // SCHED_FIFO at `priority` for the serving thread (real-time runs: the
     // master's answers must not wait for the machine's other work). "" when

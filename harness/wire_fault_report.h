@@ -1,0 +1,47 @@
+#pragma once
+// The case's wire faults (emulators/wire_faults.h) between the run and the
+// judge: what the run injected goes into the trace, and the judge reports it
+// beside what the trace itself shows, as metrics in results.json:
+//
+//   GNSS (gnss.wire_faults; meta `gnss_wire_faults`, only when a rate is on)
+//     gnss_sentences_count            sentences on device/gnss/nmea (what the wire carried)
+//     gnss_bad_sentences_count        of them, those the rig's NMEA parser rejects
+//     gnss_damaged_sentences_count    sentences the faults damaged (injected), of which
+//     gnss_lost_sentences_count         every byte lost: nothing on the wire
+//     gnss_damaged_sentences_parsed_count  damaged and still well-formed with a right
+//                                     checksum (NMEA's XOR misses two equal lost bytes)
+//     gnss_bytes_lost_count, gnss_corrupt_checksums_count, gnss_truncated_sentences_count
+//     controller_nmea_rejected_count  the controller's own count (its last status), when it publishes one
+//   Modbus RTU (board.line_noise): counts in results.json's board_io block, `line_noise`.
+#include <cstdint>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "emulators/wire_faults.h"
+#include "harness/case_spec.h"
+#include "harness/judge.h"
+#include "harness/metrics.h"
+
+namespace rig::harness {
+
+// The trace's meta key for the GNSS faults.
+inline constexpr const char* kGnssWireFaultsMeta = "gnss_wire_faults";
+
+emulators::NmeaWireFaultRates nmea_wire_fault_rates(const GnssWireFaultsSpec& spec);
+// {"rates": {...pct}, "injected": {...counts}} for the trace's meta.
+nlohmann::json gnss_wire_fault_json(const GnssWireFaultsSpec& spec, const emulators::NmeaWireFaultCounts& counts);
+
+// The metrics above from a trace with meta `gnss_wire_faults`; none without it.
+// Throws std::runtime_error for a malformed meta value.
+MetricSet gnss_wire_fault_metrics(const RecordedTrace& trace);
+
+struct BenchWires;
+// Puts the case's board.line_noise on its Modbus RTU slave, seeded from the
+// case seed; returns it (for its counts), or null when the case has none.
+std::shared_ptr<emulators::RtuLineNoise> install_line_noise(const CaseSpec& spec, std::uint64_t seed,
+                                                            BenchWires& wires);
+// The `line_noise` block of board_io: rates and counts.
+nlohmann::json line_noise_json(const emulators::RtuLineNoise& noise);
+
+}  // namespace rig::harness
