@@ -132,6 +132,29 @@ TEST(HostileInput, SpecialFilesAsCaseFilesAreRefusedByType) {
     }
 }
 
+// In a suite folder, a FIFO, a link to a device or a link loop with a case
+// file's name is refused by type, naming it (it was skipped unsaid before), and
+// the good case beside them does not run either.
+TEST(HostileInput, SpecialFilesInASuiteFolderAreRefusedByTypeNotSkipped) {
+    const fs::path dir = rig::testing::fresh_dir("hostile-special-suite");
+    const fs::path suite = dir / "suite";
+    fs::create_directories(suite / "nested.yaml");  // a folder with a case's name is walked into
+    std::ofstream(suite / "nested.yaml" / "good.yaml") << short_case_named("name: good");
+    ASSERT_EQ(::mkfifo((suite / "a-fifo.yaml").c_str(), 0600), 0);
+    fs::create_symlink("/dev/zero", suite / "zero.yml");
+    fs::create_symlink("loop.yaml", suite / "loop.yaml");
+    const Outcome outcome = rig("run " + quoted(suite) + " --out " + quoted(dir / "out"), dir);
+    EXPECT_EQ(outcome.exit_code, 2) << outcome.log;
+    for (const std::string& expected :
+         {(suite / "a-fifo.yaml").string() + ": (file): is a FIFO (named pipe), expected a regular file",
+          (suite / "zero.yml").string() + ": (file): is a character device, expected a regular file",
+          (suite / "loop.yaml").string() + ": (file): cannot examine: Too many levels of symbolic links",
+          std::string("rig: 3 case file error(s); nothing was run")}) {
+        EXPECT_NE(outcome.log.find(expected), std::string::npos) << expected << "\n" << outcome.log;
+    }
+    EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(HostileInput, SpecialFilesGivenToNmeaDecodeAreRefusedByType) {
     const fs::path dir = rig::testing::fresh_dir("hostile-special-nmea");
     const fs::path fifo = dir / "capture.fifo";
