@@ -17,6 +17,7 @@
 #include "harness/nmea_decode_tool.h"
 #include "harness/bench_emulate.h"
 #include "harness/bench_hid.h"
+#include "harness/cli_checks.h"
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
 #include "harness/case_runner.h"
@@ -159,7 +160,7 @@ int main(int argc, char** argv) {
     auto* run = app.add_subcommand("run", "run case files (or directories of them) and judge them");
     run->add_option("cases", case_inputs, "case files or directories")->required();
     run->add_option("--out", run_options.out_dir, "output directory (results.json, junit.xml, report, traces)");
-    auto* seed_option = run->add_option("--seed", seed, "override every case's seed");
+    auto* seed_option = run->add_option("--seed", seed, "override every case's seed")->check(rig::harness::unsigned_decimal_check());
     run->add_option("--jobs", run_options.jobs, "cases run at once, each on its own DDS domain")
         ->check(CLI::Range(1, 16));
     std::uint32_t domain = 0;

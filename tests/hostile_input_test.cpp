@@ -119,6 +119,30 @@ TEST(HostileInput, ADropoutLongerThanTheCaseIsRefusedAtItsKey) {
     EXPECT_FALSE(fs::exists(dir / "out" / "results.json"));
 }
 
+// Numbers on the command line: a seed that is not an unsigned 64-bit decimal
+// integer (negative, past 2^64 - 1, written as a float) is refused, never
+// wrapped or rounded into another seed; `rig emulate gnss --seed` alike.
+TEST(HostileInput, SeedsOutsideUnsigned64BitIntegersAreRefused) {
+    const fs::path dir = rig::testing::fresh_dir("hostile-seed");
+    const std::string case_file = quoted(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"-1", "must be a non-negative integer in decimal digits, got '-1'"},
+        {"18446744073709551616", "must be at most 18446744073709551615, got 18446744073709551616"},
+        {"1e3", "must be a non-negative integer in decimal digits, got '1e3'"},
+        {"0x10", "must be a non-negative integer in decimal digits, got '0x10'"},
+    };
+    for (const auto& [seed, problem] : bad) {
+        SCOPED_TRACE(seed);
+        for (const std::string& command : {"run " + case_file + " --out " + quoted(dir / "out"),
+                                           "emulate gnss " + case_file + " --pty"}) {
+            const Outcome outcome = rig(command + " --seed " + seed, dir);
+            EXPECT_NE(outcome.exit_code, 0) << outcome.log;
+            EXPECT_NE(outcome.log.find("--seed: " + problem), std::string::npos) << command << "\n" << outcome.log;
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(HostileInput, SpecialFilesAsCaseFilesAreRefusedByType) {
     const fs::path dir = rig::testing::fresh_dir("hostile-special-case");
     const fs::path fifo = dir / "fifo.yaml";
