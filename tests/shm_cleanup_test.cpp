@@ -232,8 +232,8 @@ TEST(ShmCleanup, AKilledControllersSegmentsAreRemovedByTheNextRun) {
         EXPECT_FALSE(fs::exists(rig::kPosixShmDir / lock)) << lock;
         EXPECT_FALSE(fs::exists(rig::kPosixShmDir / lock.substr(0, lock.size() - 3))) << lock;
     }
-    EXPECT_NE(read_all(dir / "rig.log").find("Fast DDS shared-memory segment(s)"), std::string::npos)
-        << read_all(dir / "rig.log");
+    // Not asserted: that this run's message names them. Under a parallel ctest
+    // another test's `rig run` may start first and remove them itself.
 }
 
 }  // namespace
