@@ -229,6 +229,13 @@ TEST(HostileInput, OutputDirectoriesThatCannotTakeResultsAreRefusedBeforeAnyCase
         EXPECT_EQ(outcome.log.find("short-fusion"), std::string::npos) << "no case may start: " << outcome.log;
     }
     EXPECT_EQ(read_all(dir / "a-file"), "not a directory\n");
+    // `rig bench` writes its runs under --out too: checked before its minutes of runs.
+    for (const Bad& out : {bad[1], bad[3]}) {
+        const Outcome outcome = rig("bench " + quoted(case_file) + " --repeat 1 --out " + quoted(out.out), dir);
+        EXPECT_EQ(outcome.exit_code, 2) << outcome.log;
+        EXPECT_EQ(outcome.log, "rig bench: --out " + out.out.string() + ": " + out.problem +
+                                   " (or a path where one can be made); nothing was run\n");
+    }
 
     // Read-only: as a user, a directory without write permission; as root (who
     // writes through permissions) a read-only mount.
