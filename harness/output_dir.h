@@ -14,9 +14,10 @@ namespace rig::harness {
 
 // `rig run`'s exit status when the cases ran but results.json / junit.xml /
 // report.txt could not be written (a full disk, the directory gone): distinct
-// from 0 (all passed), 1 (a case failed), 2 (nothing run: bad input) and 128 + N
-// (stopped by signal N), so that no script takes the run for judged.
-inline constexpr int kExitResultsNotWritten = 3;
+// from 0 (all passed), 1 (a case failed), 2 (nothing run: bad input), 3 (a
+// real-time case invalid: the rig overloaded) and 128 + N (stopped by signal
+// N), so that no script takes the run for judged.
+inline constexpr int kExitResultsNotWritten = 4;
 
 // What is wrong with an output directory. what(): "--out PATH: PROBLEM".
 class OutputDirError : public std::runtime_error {

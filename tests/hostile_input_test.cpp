@@ -8,7 +8,7 @@
 //    input is refused by type (never a hang, never a crash).
 //  * an output directory that cannot take results (a path through a regular
 //    file, a device, a read-only or full file system) is refused before any case
-//    runs; a disk that fills during the run ends it with a clean error (exit 3),
+//    runs; a disk that fills during the run ends it with a clean error (exit 4),
 //    never an abort, and what it wrote stays a readable trace.
 // Every refusal comes before the first case; only the full-disk runs start
 // DDS, in a network namespace of their own with only loopback up.
@@ -304,7 +304,7 @@ TEST(HostileInput, ADiskThatFillsDuringTheRunEndsItCleanly) {
                   std::string::npos)
             << log;
         const std::string listing = read_all(dir / "listing.txt");
-        if (exit_code == 3) {
+        if (exit_code == 4) {
             EXPECT_NE(log.find("rig: results not written: "), std::string::npos) << log;
             EXPECT_EQ(listing.find("results.json"), std::string::npos) << "the earlier run's results stay: " << listing;
         } else {
