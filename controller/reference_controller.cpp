@@ -34,12 +34,17 @@ void ReferenceController::configure(DdsContext& dds) {
     // what it reads would not. The rig must find it from discovery.
     dds_ = &dds;
     const ControllerFaults& faults = config_.faults;
+    // Data sharing off, as on every endpoint of the project's profile: its
+    // segments (fast_datasharing_*) have no owner lock, so a killed controller's
+    // could never be told from a live one's and would stay in /dev/shm for good.
+    auto undeclared_qos = dds.subscriber().get_default_datareader_qos();
+    undeclared_qos.data_sharing().off();
     if (faults.read_topic == topics::kVehicleTruth) {
-        undeclared_reader_ = dds.subscriber().create_datareader(dds.topic<msg::VehicleTruth>(topics::kVehicleTruth),
-                                                                dds.subscriber().get_default_datareader_qos());
+        undeclared_reader_ =
+            dds.subscriber().create_datareader(dds.topic<msg::VehicleTruth>(topics::kVehicleTruth), undeclared_qos);
     } else if (faults.read_topic == topics::kHydraulicsTruth) {
-        undeclared_reader_ = dds.subscriber().create_datareader(
-            dds.topic<msg::HydraulicsTruth>(topics::kHydraulicsTruth), dds.subscriber().get_default_datareader_qos());
+        undeclared_reader_ =
+            dds.subscriber().create_datareader(dds.topic<msg::HydraulicsTruth>(topics::kHydraulicsTruth), undeclared_qos);
     }
     if (!faults.read_topic.empty() && undeclared_reader_ == nullptr) {
         throw std::runtime_error("fault read_topic: cannot create a reader on " + faults.read_topic);

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 
+#include "harness/cli_checks.h"
 #include "emulators/gnss_g970.h"
 #include "harness/case_world.h"
 #include "harness/case_spec.h"
@@ -87,7 +88,7 @@ EmulateBenchCommand::EmulateBenchCommand(CLI::App& app) {
     gnss_->add_flag("--pty", options_.pty, "create a pseudo-terminal and write there (its path is printed)");
     gnss_->add_option("--link", options_.link, "with --pty: a symlink to it, e.g. /tmp/gnss0");
     gnss_->add_option("--baud", options_.baud, "baud rate (8N1)")->capture_default_str();
-    gnss_->add_option("--seed", seed_, "override the case's seed");
+    gnss_->add_option("--seed", seed_, "override the case's seed")->check(rig::harness::unsigned_decimal_check());
     gnss_->add_option("--seconds", seconds_, "stop after this many seconds (default: the route's end)");
 }
 

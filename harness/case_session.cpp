@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "rig/host/shm_cleanup.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/wire/hid_board.h"
 #include "rig/wire/modbus_protocol.h"
@@ -166,6 +167,8 @@ std::string CaseSession::start_in_process_controller(const CaseSpec& spec, const
 
 CaseSession::~CaseSession() {
     if (controller_) controller_->stop(std::chrono::milliseconds(500));
+    // A controller that had to be killed left its Fast DDS segments in /dev/shm (rig/host/shm_cleanup.h).
+    remove_dead_participant_segments();
 }
 
 std::string CaseSession::controller_mode() const {

@@ -857,7 +857,12 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
                 continue;
             }
             const std::string extension = it->path().extension().string();
-            if ((extension != ".yaml" && extension != ".yml") || !it->is_regular_file()) continue;
+            if (extension != ".yaml" && extension != ".yml") continue;
+            // A folder named like a case is walked into; anything else with a case's
+            // name (a FIFO, a link to a device, a link loop) is kept, for
+            // load_case_file to refuse by type, naming it, rather than skipped unsaid.
+            std::error_code type_error;
+            if (it->is_directory(type_error) && !type_error) continue;
             cases.push_back(it->path());
         }
         if (cases.empty()) {

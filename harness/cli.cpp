@@ -18,6 +18,7 @@
 #include "harness/nmea_decode_tool.h"
 #include "harness/bench_emulate.h"
 #include "harness/bench_hid.h"
+#include "harness/cli_checks.h"
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
 #include "harness/shard.h"
@@ -26,12 +27,14 @@
 #include "harness/case_world.h"
 #include "harness/html_report.h"
 #include "harness/judge_command.h"
+#include "harness/output_dir.h"
 #include "harness/results_writer.h"
 #include "harness/run_interrupt.h"
 #include "rig/runtime/clock.h"
 #include "rig/config/config_error.h"
 #include "harness/speed_bench.h"
 #include "rig/host/dds_check.h"
+#include "rig/host/shm_cleanup.h"
 #include "rig/host/dds_pingpong.h"
 
 namespace {
@@ -101,6 +104,19 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         std::cerr << "rig: " << error.what() << "\n";
         return 2;
     }
+    // An output directory that cannot take results is refused now, not after the cases ran.
+    try {
+        prepare_output_directory(options.out_dir);
+    } catch (const OutputDirError& error) {
+        std::cerr << "rig: " << error.what() << "; nothing was run\n";
+        return 2;
+    }
+    // What killed participants of earlier runs left in /dev/shm (rig/host/shm_cleanup.h).
+    if (const rig::ShmCleanup cleaned = rig::remove_dead_participant_segments(); !cleaned.removed.empty()) {
+        std::cerr << "rig: removed " << cleaned.removed.size() << " Fast DDS shared-memory segment(s) ("
+                  << cleaned.bytes_freed / 1024 << " KiB) of participants that were killed, from "
+                  << rig::kPosixShmDir.string() << "\n";
+    }
     // SIGINT / SIGTERM from here on stop the cases, not the rig: the results of
     // what ran are still written (harness/run_interrupt.h).
     install_run_interrupt_handlers();
@@ -114,10 +130,25 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     }
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
-    const std::vector<std::string> report_problems =
-        write_results(options.out_dir, results, summary, figures, HtmlReportOptions{});
+    // A disk that filled during the run: the table still goes to the terminal,
+    // the failure is told, never an abort (harness/output_dir.h).
+    std::vector<std::string> report_problems;
+    std::string results_problem;
+    try {
+        report_problems = write_results(options.out_dir, results, summary, figures, HtmlReportOptions{});
+    } catch (const std::exception& error) {
+        results_problem = error.what();
+    }
     std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
     for (const std::string& problem : report_problems) std::cerr << "rig: report: " << problem << "\n";
+    if (!results_problem.empty()) {
+        std::cerr << "rig: results not written: " << results_problem << "\n";
+        for (const std::string& name : remove_stale_results(options.out_dir)) {
+            std::cerr << "rig: removed " << (options.out_dir / name).string()
+                      << " of an earlier run, so that it is not taken for this run's\n";
+        }
+        return kExitResultsNotWritten;
+    }
     std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
               << (options.out_dir / "report.txt").string() << ", " << (options.out_dir / "report.html").string()
               << "\n";
@@ -151,7 +182,7 @@ int main(int argc, char** argv) {
     auto* run = app.add_subcommand("run", "run case files (or directories of them) and judge them");
     run->add_option("cases", case_inputs, "case files or directories")->required();
     run->add_option("--out", run_options.out_dir, "output directory (results.json, junit.xml, report, traces)");
-    auto* seed_option = run->add_option("--seed", seed, "override every case's seed");
+    auto* seed_option = run->add_option("--seed", seed, "override every case's seed")->check(rig::harness::unsigned_decimal_check());
     run->add_option("--jobs", run_options.jobs, "cases run at once, each on its own DDS domain")
         ->check(CLI::Range(1, 16));
     std::uint32_t domain = 0;

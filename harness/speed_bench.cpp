@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/output_dir.h"
 #include "harness/case_spec.h"
 #include "harness/results_writer.h"
 
@@ -98,6 +99,13 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     }
     if (specs.empty()) {
         err << "rig bench: no case given\n";
+        return 2;
+    }
+    // Where bench.json and the runs' traces go, checked before minutes of runs (harness/output_dir.h).
+    try {
+        prepare_output_directory(options.out_dir);
+    } catch (const OutputDirError& error) {
+        err << "rig bench: " << error.what() << "; nothing was run\n";
         return 2;
     }
     const std::string load_before = load_average();

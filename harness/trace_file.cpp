@@ -329,6 +329,14 @@ std::string TraceFile::finish(const TraceOutcome& outcome) {
     if (db_ == nullptr) return sha256_;
     sync();
     stop_writer();
+    // The batch transaction is gone only when SQLite rolled it back after a failed
+    // write (a full disk): its rows are lost. Writing the outcome now would commit
+    // it alone, beside a digest of rows the file no longer has; the file keeps
+    // outcome `running` instead, and the error that lost the rows is the one told.
+    if (sqlite3_get_autocommit(db_) != 0) {
+        throw std::runtime_error("trace " + file_.string() +
+                                 ": a write failed earlier and its batch of rows was rolled back; not finished");
+    }
     if (digest_text_.empty()) {
         unsigned char hash[EVP_MAX_MD_SIZE];
         unsigned int length = 0;
