@@ -86,6 +86,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     // what ran are still written (harness/run_interrupt.h).
     install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
+    const std::string started_utc = rig::utc_date_time_now();
     const auto runs = run_cases(specs, options, std::cerr);
     std::vector<CaseResult> results;
     std::vector<CaseFigures> figures;
@@ -95,6 +96,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     }
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
+    summary.started_utc = started_utc;
     const std::vector<std::string> report_problems =
         write_results(options.out_dir, results, summary, figures, HtmlReportOptions{});
     std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
