@@ -607,7 +607,11 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
 }
 
 std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary) {
-    std::string report = result_table(results, summary, /*color=*/false);
+    return result_table(results, summary, /*color=*/false) + result_details(results);
+}
+
+std::string result_details(const std::vector<CaseResult>& results) {
+    std::string report;
     for (const CaseResult& result : results) {
         report += "\n== " + result.name + " (" + result.file + ")\n";
         report += "result: " + status_word(result) + "   seed: " + std::to_string(result.seed) +

@@ -161,6 +161,8 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
 
 // The table followed by per-case details (file, seed, trace, all metrics, error).
 std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary);
+// The per-case details alone (`rig run --verbose` prints them after the table).
+std::string result_details(const std::vector<CaseResult>& results);
 
 // Writes out_dir/results.json, junit.xml and report.txt (creating out_dir),
 // each through a temporary file renamed into place, so a reader never sees a
