@@ -140,8 +140,9 @@ std::optional<double> estimate_seconds_left(const std::vector<CaseToCome>& cases
     return lockstep_left / parallel + realtime_left;
 }
 
-TerminalProgress::TerminalProgress(std::ostream& out, Verbosity verbosity, int jobs, std::size_t width)
-    : out_(out), verbosity_(verbosity), jobs_(jobs), width_(width) {}
+TerminalProgress::TerminalProgress(std::ostream& out, Verbosity verbosity, int jobs, std::size_t width,
+                                   bool redraw_on_timer)
+    : out_(out), verbosity_(verbosity), jobs_(jobs), width_(width), redraw_on_timer_(redraw_on_timer) {}
 
 TerminalProgress::~TerminalProgress() { finish(); }
 
@@ -166,6 +167,7 @@ void TerminalProgress::runs_planned(const std::vector<CaseInstance>& runs, const
         }
         run_wall_ = WallStopwatch();
     }
+    if (!redraw_on_timer_) return;
     ticker_ = std::thread([this] {
         for (;;) {
             {

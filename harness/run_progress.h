@@ -90,7 +90,9 @@ std::optional<double> estimate_seconds_left(const std::vector<CaseToCome>& cases
 // finish() (or the destructor) before the result table is printed.
 class TerminalProgress final : public RunObserver {
 public:
-    TerminalProgress(std::ostream& out, Verbosity verbosity, int jobs, std::size_t width);
+    // `width`: the terminal's columns; `redraw_on_timer` false draws only when
+    // a case starts or ends (for tests: no thread writing to `out`).
+    TerminalProgress(std::ostream& out, Verbosity verbosity, int jobs, std::size_t width, bool redraw_on_timer = true);
     ~TerminalProgress() override;
     TerminalProgress(const TerminalProgress&) = delete;
     TerminalProgress& operator=(const TerminalProgress&) = delete;
@@ -118,6 +120,7 @@ private:
     Verbosity verbosity_;
     int jobs_;
     std::size_t width_;
+    bool redraw_on_timer_;
     mutable std::mutex mutex_;
     std::vector<Run> runs_;
     std::deque<CaseClock> clocks_;  // one per run; deque: CaseClock cannot move
