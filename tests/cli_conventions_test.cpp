@@ -171,6 +171,28 @@ TEST(CliConventions, OnATerminalAStatusLineAndColourUnlessNoColor) {
     EXPECT_EQ(quiet.out, "2 passed, 0 failed\r\n") << quiet.out;  // the terminal shows \n as \r\n
 }
 
+// A real-time case runs on the wall clock (about 16 s here): the status line
+// shows its clock against its length as it goes. Registered apart and alone
+// (tests/CMakeLists.txt), like every real-time run.
+TEST(CliConventionsRealTime, ARealTimeCaseShowsItsClockOnATerminal) {
+    const fs::path file = write_case("real-time-clock");
+    std::string text = read_all(file);
+    text.replace(text.find("seed: 5"), std::string("seed: 5").size(), "seed: 5\nmode: realtime");
+    text.replace(text.find("accel_m_s2: 0.5, start_m: -8"), std::string("accel_m_s2: 0.5, start_m: -8").size(),
+                 "accel_m_s2: 2.0, start_m: -6");
+    std::ofstream(file) << text;
+    const Outcome run = rig_on_terminal("NO_COLOR=1", "run '" + file.string() + "'" + out_dir("tty-realtime"), "tty-realtime");
+    EXPECT_NE(run.out.find("rig: [1/1] real-time-clock (real time) "), std::string::npos) << run.out;
+    // Its clock moves: two different readings of it, each against the case's length.
+    std::set<std::string> readings;
+    const std::regex clock(R"(\(real time\) t (\d+\.\d)/(\d+\.\d) s \|)");
+    for (auto it = std::sregex_iterator(run.out.begin(), run.out.end(), clock); it != std::sregex_iterator(); ++it) {
+        EXPECT_LE(std::stod((*it)[1]), std::stod((*it)[2]) + 0.5) << (*it)[0];
+        readings.insert((*it)[1]);
+    }
+    EXPECT_GE(readings.size(), 2u) << run.out;
+}
+
 // The subcommands in `rig [COMMAND...] --help`.
 std::set<std::string> subcommands_in_help(const std::string& args, const std::string& tag) {
     const Outcome help = rig(args + " --help", tag);
