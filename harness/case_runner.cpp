@@ -39,6 +39,11 @@ constexpr double kVehicleTruthRateHz = 20.0;
 constexpr double kHydraulicsTruthRateHz = 100.0;
 // SCHED_FIFO priority the harness asks for in real-time runs (the controller asks for 40).
 constexpr int kRealtimePriority = 50;
+// The threads that carry the bench wires' bytes (the Modbus slave answering a
+// board's polls, the pty forwarder): above the controller, so a board's request
+// is answered on time however busy the machine, below the master, whose
+// deadlines make the devices' timing.
+constexpr int kWireThreadPriority = 45;
 // A bench wire whose bytes wait unread this long has nobody on its far end.
 constexpr std::chrono::milliseconds kWireUnreadBound{2000};
 
@@ -93,6 +98,7 @@ struct RunFacts {
     double stepping_wall_seconds = 0.0;
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
+    nlohmann::json lateness;  // real time: lateness_json(), null in lockstep
     std::optional<BoardAttachment> board_attachment;  // controller: external
     nlohmann::json board_io;  // harness/board_attach.h board_io_report(), null without a Modbus wire
 };
@@ -184,6 +190,35 @@ void record_own_topics(const std::vector<std::string>& topics, TraceRecorder& tr
     }
 }
 
+// The rig's own lateness against the case's bound, for the judge's verdict
+// (judge.cpp: a non-empty `overloaded` makes the run invalid).
+nlohmann::json lateness_json(const LatenessVerdict& verdict, const std::optional<RigFaultsSpec>& faults) {
+    nlohmann::json devices = nlohmann::json::object();
+    for (const auto& [device, mine] : verdict.devices) {
+        devices[device] = {{"emissions", mine.emissions},
+                           {"late", mine.late},
+                           {"max_ms", mine.max_ms},
+                           {"max_at_s", ns_to_seconds(mine.max_deadline_ns)}};
+    }
+    const bool any_late = !verdict.first_late_device.empty();
+    return {{"bound",
+             {{"late_after_ms", verdict.bound.late_after_ms},
+              {"max_late_pct", verdict.bound.max_late_pct},
+              {"max_lateness_ms", verdict.bound.max_lateness_ms}}},
+            {"emissions", verdict.emissions},
+            {"late", verdict.late},
+            {"late_pct", verdict.late_pct},
+            {"max_ms", verdict.max_ms},
+            {"worst_device", verdict.worst_device},
+            {"worst_at_s", ns_to_seconds(verdict.worst_deadline_ns)},
+            {"first_late_device", any_late ? nlohmann::json(verdict.first_late_device) : nlohmann::json(nullptr)},
+            {"first_late_at_s", any_late ? nlohmann::json(ns_to_seconds(verdict.first_late_deadline_ns)) : nlohmann::json(nullptr)},
+            {"devices", std::move(devices)},
+            {"injected_stall", faults ? nlohmann::json{{"at_s", faults->master_stall_at_s}, {"for_s", faults->master_stall_for_s}}
+                                      : nlohmann::json(nullptr)},
+            {"overloaded", verdict.overloaded}};
+}
+
 LockstepTimeouts timeouts_of(const CaseSpec& spec) {
     LockstepTimeouts timeouts;
     timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
@@ -219,11 +254,30 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     }
 }
 
+// The bench wires' threads at SCHED_FIFO `priority`; what was granted, for the run's facts.
+std::string raise_wire_threads(BenchWires& wires, int priority) {
+    std::vector<std::string> refused;
+    int raised = 0;
+    const auto raise = [&](const std::string& what, const std::string& why_not) {
+        if (why_not.empty()) ++raised;
+        else refused.push_back(what + ": " + why_not);
+    };
+    if (wires.modbus_link) raise("pty forwarder", wires.modbus_link->raise_to_realtime(priority));
+    if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(wires.board_io.get())) {
+        raise("Modbus slave", modbus_wire->slave().raise_to_realtime(priority));
+    }
+    if (raised == 0 && refused.empty()) return {};
+    std::string text = "; wire threads: " + std::to_string(raised) + " at SCHED_FIFO " + std::to_string(priority);
+    for (const std::string& why : refused) text += ", " + why;
+    return text;
+}
+
 // Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
 void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
     facts.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
+    facts.realtime_scheduling += raise_wire_threads(session.wires(), kWireThreadPriority);
     RealtimeMaster master(dds, timeouts_of(spec));
     for (Node* node : nodes.all) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });
@@ -238,7 +292,13 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
     });
     master.set_watchdog([&watchdog] { watchdog(); });
     master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
+    master.set_lateness_bound(spec.realtime);
+    if (spec.rig_faults) {
+        master.inject_stall(seconds_to_ns(spec.rig_faults->master_stall_at_s),
+                            seconds_to_ns(spec.rig_faults->master_stall_for_s));
+    }
     auto collect_jitter = [&] {
+        facts.lateness = lateness_json(master.lateness(), spec.rig_faults);
         for (const auto& [device, stats] : master.emission_jitter()) {
             // Nodes that only react to inputs (the NMEA serial adapter, a switch
             // never toggled) had no deadline to be late for: nothing to report.
@@ -290,6 +350,7 @@ nlohmann::json run_facts_json(const RunFacts& facts, double wall_seconds) {
                           {"realtime_scheduling", facts.realtime_scheduling},
                           {"emission_jitter", std::move(jitter)}};
     if (!facts.board_io.is_null()) run["board_io"] = facts.board_io;
+    if (!facts.lateness.is_null()) run["lateness"] = facts.lateness;
     return run;
 }
 

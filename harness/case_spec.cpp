@@ -523,6 +523,11 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
     if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
         root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
     }
+    for (const char* section : {"realtime", "rig_faults"}) {
+        if (root.has(section) && spec.mode != RunMode::realtime) {
+            root.fail(section, "bounds and faults of the rig's real-time loop: only with `mode: realtime`");
+        }
+    }
     if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
         root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
     }
@@ -716,6 +721,8 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.static_flow = read_static_flow(root.section("static_flow"));
     spec.wiring = read_wiring(root.section("wiring"));
     spec.board = read_board_spec(root.section("board"));
+    spec.realtime = read_realtime_section(root.section("realtime"));
+    spec.rig_faults = read_rig_faults(root.section("rig_faults"));
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
     spec.expect = read_expect(root.section("expect"));
@@ -807,6 +814,10 @@ void check_case_timeline(const CaseSpec& spec, double case_end_s, double breakpo
     }
     for (const GnssDegraded& degraded : spec.gnss.degraded) {
         check(degraded.at_s, degraded.for_s, degraded.at_location, degraded.for_location, "the degraded episode");
+    }
+    if (spec.rig_faults) {
+        check(spec.rig_faults->master_stall_at_s, spec.rig_faults->master_stall_for_s, spec.rig_faults->at_location,
+              spec.rig_faults->for_location, "the rig's stall");
     }
 }
 

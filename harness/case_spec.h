@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "harness/board_spec.h"
+#include "harness/realtime_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
 
@@ -316,6 +317,10 @@ struct CaseSpec {
     StaticFlowSpec static_flow;
     WiringSpec wiring;
     BoardSpec board;  // harness/board_spec.h: attach, silence and fail-safe of a wired board
+    // harness/realtime_spec.h (`mode: realtime` only): the bound on the rig's own
+    // emission lateness, and the self-test faults of the rig itself.
+    LatenessBound realtime;
+    std::optional<RigFaultsSpec> rig_faults;
     ControllerSpec controller;
     // Limits as written in the file (metric name -> max allowed value, |v| <= 1e6); the
     // harness judges against effective_limits(), i.e. these over the defaults.

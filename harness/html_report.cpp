@@ -115,9 +115,10 @@ std::optional<std::string> read_file(const fs::path& path) {
 
 // ---------------------------------------------------------------- case facts
 
-enum class Verdict { pass, fail, expected_failure_ok };
+enum class Verdict { pass, fail, expected_failure_ok, invalid };
 
 Verdict verdict_of(const CaseResult& result) {
+    if (case_invalid(result)) return Verdict::invalid;
     if (!case_passed(result)) return Verdict::fail;
     return result.expected_failure ? Verdict::expected_failure_ok : Verdict::pass;
 }
@@ -128,6 +129,9 @@ std::string verdict_badge(Verdict verdict) {
         case Verdict::expected_failure_ok:
             return "<span class=\"badge xfail\" title=\"broke exactly the limits the case expects to "
                    "break\">expected failure OK</span>";
+        case Verdict::invalid:
+            return "<span class=\"badge invalid\" title=\"the rig was overloaded: the run cannot judge the "
+                   "controller\">INVALID</span>";
         case Verdict::fail: break;
     }
     return "<span class=\"badge fail\">FAIL</span>";
@@ -744,18 +748,53 @@ std::string area_shading(const CaseFigures& figures, bool with_labels) {
     return script;
 }
 
+// Fig. 15's scale. Where the sprayer stood with its nozzles open (starting a
+// pass from standstill, stopping at the breakpoint) a few rows get many times
+// what a moving boom leaves; a scale set by them flattens everything the figure
+// is about. The scale is cut at kDoseScaleOverMedian times the median of the
+// rows that got spray, and the rows above it are counted on the figure.
+constexpr double kDoseScaleOverMedian = 3.0;
+
+struct DoseScale {
+    double top = 0.0;             // the y axis' top, uL/cm^2 (0: nothing sprayed)
+    std::size_t rows_above = 0;   // rows whose total is off the scale
+    double highest = 0.0;         // the largest total
+};
+
+DoseScale dose_scale(const std::vector<DoseRow>& rows) {
+    std::vector<double> sprayed;
+    DoseScale scale;
+    for (const DoseRow& row : rows) {
+        if (row.total > 0.0) sprayed.push_back(row.total);
+        scale.highest = std::max(scale.highest, row.total);
+    }
+    if (sprayed.empty()) return scale;
+    std::nth_element(sprayed.begin(), sprayed.begin() + static_cast<std::ptrdiff_t>(sprayed.size() / 2), sprayed.end());
+    const double cut = kDoseScaleOverMedian * sprayed[sprayed.size() / 2];
+    scale.top = std::min(scale.highest, cut);
+    for (const DoseRow& row : rows) scale.rows_above += row.total > cut ? 1 : 0;
+    return scale;
+}
+
+// The label on a figure whose scale cut rows off.
+std::string off_scale_label(int tag, const DoseScale& scale, const std::string& highest_text) {
+    if (scale.rows_above == 0) return {};
+    return "set label " + std::to_string(tag) + " " +
+           gnuplot_string(std::to_string(scale.rows_above) + " row" + (scale.rows_above == 1 ? "" : "s") +
+                          " off the scale (up to " + highest_text + ") where the sprayer stood spraying") +
+           " at graph 0.99, graph 0.72 right front boxed textcolor rgb '#8d1010'\n" +
+           "set style textbox opaque fillcolor rgb 'white' noborder\n";
+}
+
 // Row deposits across the breakpoint, as the paper's Fig. 15 (before its normalisation).
 std::optional<Panel> dose_panel(const CaseFigures& figures, const std::vector<DoseRow>& rows) {
     if (rows.empty()) return std::nullopt;
+    const DoseScale scale = dose_scale(rows);
     Extent y_extent;
     y_extent.include(0.0);
+    y_extent.include(scale.top);
     std::vector<std::vector<double>> data;
-    for (const DoseRow& row : rows) {
-        y_extent.include(row.first_pass);
-        y_extent.include(row.continuation);
-        y_extent.include(row.total);
-        data.push_back({row.along_m, row.first_pass, row.continuation, row.total});
-    }
+    for (const DoseRow& row : rows) data.push_back({row.along_m, row.first_pass, row.continuation, row.total});
     Panel panel;
     panel.caption = "Dose per row along the track across the breakpoint";
     panel.width = 860;
@@ -770,6 +809,7 @@ std::optional<Panel> dose_panel(const CaseFigures& figures, const std::vector<Do
     script += "set yrange " + y_extent.range(0.0, 0.25) + "\n";
     script += "set key outside top center horizontal\n";
     script += area_shading(figures, true);
+    script += off_scale_label(3, scale, shown_number(scale.highest, 3) + " uL/cm^2");
     script += vertical_marker(2, figures.breakpoint_along_m, kBreakpointColor, "1", "breakpoint", false, 0.82);
     script += "plot $dose using 1:2 with linespoints lw 1.5 pt 7 ps 0.5 lc " + rgb(kFirstPassColor) + " title " +
               gnuplot_string("first pass") + ", $dose using 1:3 with linespoints lw 1.5 pt 7 ps 0.5 lc " +
@@ -784,6 +824,9 @@ std::optional<Panel> normalised_dose_panel(const CaseFigures& figures, const std
     Extent totals;
     for (const DoseRow& row : rows) totals.include(row.total);
     if (totals.empty() || !(totals.high > totals.low)) return std::nullopt;  // Eq. 9 undefined
+    // Eq. 9 as the paper defines it (its max is a standing row's, if any), shown on the same cut scale.
+    const DoseScale scale = dose_scale(rows);
+    const double top = (scale.top - totals.low) / (totals.high - totals.low);
     std::vector<Point> normalised;
     for (const DoseRow& row : rows) {
         normalised.push_back({row.along_m, (row.total - totals.low) / (totals.high - totals.low)});
@@ -799,8 +842,9 @@ std::optional<Panel> normalised_dose_panel(const CaseFigures& figures, const std
     script += "set ylabel " + gnuplot_string("normalised (Eq. 9)") + "\n";
     script += "set lmargin 12\nset rmargin 4\n";
     script += "set xrange " + dose_x_extent(figures, rows).range(0.02, 0.02) + "\n";
-    script += "set yrange [0:1.1]\nset ytics 0.25\nset key off\n";
+    script += "set yrange [0:" + exact_number(std::max(top, 0.05) * 1.1) + "]\nset key off\n";
     script += area_shading(figures, false);
+    script += off_scale_label(3, scale, "1");
     script += vertical_marker(2, figures.breakpoint_along_m, kBreakpointColor, "1", "", false);
     script += "plot $normalised using 1:2 with linespoints lw 2 pt 5 ps 0.5 lc " + rgb(kTotalColor) + " notitle\n";
     return panel;
@@ -886,7 +930,10 @@ body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; co
 h1 { font-size: 1.7em; margin: 0 0 0.3em 0; }
 h2 { font-size: 1.3em; border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 2.2em; }
 h3 { font-size: 1.05em; margin: 1.2em 0 0.4em 0; }
-table { border-collapse: collapse; margin: 0.4em 0 0.8em 0; }
+/* A table or figure wider than the screen (a phone's 390 px) scrolls inside its
+   own box; the page never does, and figures are never shrunk below the size
+   their text was drawn for (gnuplot's 11 px). */
+table { border-collapse: collapse; margin: 0.4em 0 0.8em 0; display: block; overflow-x: auto; max-width: 100%; }
 th, td { border: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
 th { background: #f3f3f3; font-weight: 600; }
 .num { font-family: ui-monospace, "DejaVu Sans Mono", Menlo, Consolas, monospace; font-variant-numeric: tabular-nums;
@@ -899,6 +946,7 @@ th { background: #f3f3f3; font-weight: 600; }
 .badge.pass { background: #dcf3dc; color: #17611a; }
 .badge.fail { background: #fbd3d3; color: #8d1010; }
 .badge.xfail { background: #fcefc7; color: #765600; }
+.badge.invalid { background: #e8dcf5; color: #4b1d7a; }
 .over { color: #b00000; font-weight: 700; }
 td.over { background: #fdecec; }
 .expected { color: #8a6400; }
@@ -912,11 +960,15 @@ td.expected { background: #fdf6dd; }
 .notice { border: 1px solid #e0b000; background: #fff9e0; padding: 0.4em 0.8em; }
 pre { white-space: pre-wrap; word-break: break-word; margin: 0.3em 0;
       font-family: ui-monospace, "DejaVu Sans Mono", Menlo, Consolas, monospace; }
-figure { margin: 1.2em 0; }
-#suite figure { margin: 0.4em 0; max-width: 100%; }
+figure { margin: 1.2em 0; max-width: 100%; overflow-x: auto; }
+#suite figure { margin: 0.4em 0; }
 .panels { display: flex; flex-wrap: wrap; gap: 0.8em; align-items: flex-start; }
 .panels.stacked { flex-direction: column; flex-wrap: nowrap; }
-svg { max-width: 100%; height: auto; }
+svg { max-width: none; height: auto; flex: none; }
+@media (max-width: 600px) {
+  body { padding: 0 0.6em; margin-top: 0.8em; }
+  .metric-line .name { min-width: 0; margin-right: 0.5em; }
+}
 figcaption { color: #555; font-size: 0.92em; margin-top: 0.3em; max-width: 70em; }
 .figure-error { border: 1px dashed #b00000; background: #fff6f6; padding: 0.5em 0.8em; max-width: 60em; }
 .nav { font-size: 0.9em; }
@@ -924,7 +976,12 @@ figcaption { color: #555; font-size: 0.92em; margin-top: 0.3em; max-width: 70em;
 )";
 
 std::string verdict_text(const RunSummary& summary) {
-    const int total = summary.passed + summary.failed;
+    const int total = summary.passed + summary.failed + summary.invalid;
+    if (summary.invalid > 0) {
+        return "<p class=\"verdict fail\">" + std::to_string(summary.failed) + " of " + std::to_string(total) +
+               " failed, " + std::to_string(summary.invalid) +
+               " invalid (the rig was overloaded: not judged, run again on a quieter machine)</p>\n";
+    }
     if (summary.failed == 0) {
         return "<p class=\"verdict pass\">All " + std::to_string(total) + " case" + (total == 1 ? "" : "s") +
                " passed</p>\n";
@@ -936,10 +993,11 @@ std::string verdict_text(const RunSummary& summary) {
 std::string run_numbers_table(const RunSummary& summary) {
     const std::string speed_up =
         summary.wall_seconds > 0.0 ? shown_number(summary.sim_seconds / summary.wall_seconds, 3) + "\u00d7" : "\u2013";
-    std::string table = "<table class=\"run\">\n<tr><th>passed</th><th>failed</th><th>simulated</th><th>wall</th>"
+    std::string table = "<table class=\"run\">\n<tr><th>passed</th><th>failed</th><th>invalid</th><th>simulated</th><th>wall</th>"
                         "<th>speed-up (simulated / wall)</th></tr>\n";
     table += "<tr><td class=\"num\">" + std::to_string(summary.passed) + "</td><td class=\"num" +
-             (summary.failed > 0 ? " over" : "") + "\">" + std::to_string(summary.failed) + "</td><td class=\"num\">" +
+             (summary.failed > 0 ? " over" : "") + "\">" + std::to_string(summary.failed) + "</td><td class=\"num" +
+             (summary.invalid > 0 ? " over" : "") + "\">" + std::to_string(summary.invalid) + "</td><td class=\"num\">" +
              fixed_number(summary.sim_seconds, 1) + " s</td><td class=\"num\">" + fixed_number(summary.wall_seconds, 1) +
              " s</td><td class=\"num\">" + speed_up + "</td></tr>\n</table>\n";
     return table;
@@ -999,6 +1057,7 @@ std::string case_facts(const CaseResult& result) {
         }
         row("controller", placed);
     }
+    if (result.rig_lateness.is_object()) row("rig lateness", html(rig_lateness_summary(result.rig_lateness)));
     row("trace", result.trace_path.empty() ? std::string("<span class=\"muted\">none</span>")
                                            : "<span class=\"mono\">" + html(result.trace_path) + "</span>");
     row("trace_sha256", result.trace_sha256.empty() ? std::string("<span class=\"muted\">none</span>")
@@ -1146,8 +1205,15 @@ std::string dose_figure(PageBuilder& page, std::size_t index, const CaseResult& 
     }
     figure += "</div>\n<figcaption>Dose per row of the deposition grid, summed across the boom, as in the paper's "
               "Fig. 15: the first pass (before the breakpoint stop), the continuation (after the resume) and their "
-              "total; shaded areas as the harness classified them; below, the total normalised by Eq. 9."
-              "</figcaption>\n";
+              "total; shaded areas as the harness classified them; below, the total normalised by Eq. 9.";
+    if (const DoseScale scale = dose_scale(rows); scale.rows_above > 0) {
+        figure += " The scale is cut at " + std::to_string(static_cast<int>(kDoseScaleOverMedian)) +
+                  " times the median row: " + std::to_string(scale.rows_above) + " row" +
+                  (scale.rows_above == 1 ? "" : "s") + " reach up to " + html(shown_number(scale.highest, 3)) +
+                  " uL/cm<sup>2</sup>, where the sprayer stood with its nozzles open (starting from standstill, "
+                  "stopping at the breakpoint): a filter paper there is soaked, and Eq. 9's maximum is theirs.";
+    }
+    figure += "</figcaption>\n";
     figure += area_table(figures);
     return figure + "</figure>\n";
 }
@@ -1156,7 +1222,11 @@ std::string case_section(PageBuilder& page, std::size_t index, const CaseResult&
     std::string section = "<section class=\"case\" id=\"" + case_anchor(index) + "\">\n";
     section += "<h2>" + std::to_string(index + 1) + ". " + html(result.name) + " " + verdict_badge(verdict_of(result)) +
                "</h2>\n";
-    if (!result.error.empty()) {
+    if (verdict_of(result) == Verdict::invalid) {
+        section += "<div class=\"error-box\"><strong>Invalid: this run cannot judge the controller (" +
+                   html(result.error_kind) + "):</strong>\n<pre>" + html(result.error) +
+                   "</pre>The metrics below are reported, not judged; run the case again on a quieter machine.</div>\n";
+    } else if (!result.error.empty()) {
         section += "<div class=\"error-box\"><strong>The case did not run to the end (" + html(result.error_kind) +
                    (verdict_of(result) == Verdict::expected_failure_ok ? ", as the case expects" : "") +
                    "):</strong>\n<pre>" + html(result.error) + "</pre>The trace keeps every sample up to it.</div>\n";
@@ -1269,7 +1339,8 @@ HtmlReport render_html_report(const std::vector<CaseResult>& results, const std:
     out += "<meta charset=\"utf-8\"/>\n";
     out += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n";
     out += "<title>" + html(options.title) + ": " + std::to_string(summary.passed) + " passed, " +
-           std::to_string(summary.failed) + " failed</title>\n";
+           std::to_string(summary.failed) + " failed" +
+           (summary.invalid > 0 ? ", " + std::to_string(summary.invalid) + " invalid" : "") + "</title>\n";
     out += "<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
     out += "<header>\n<h1>" + html(options.title) + "</h1>\n";
     out += verdict_text(summary) + run_numbers_table(summary);

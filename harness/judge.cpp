@@ -13,6 +13,7 @@
 #include "harness/boundary_judge.h"
 #include "harness/trace_file.h"
 #include "idl/topics.h"
+#include "rig/runtime/failure_kind.h"
 
 namespace rig::harness {
 
@@ -434,6 +435,7 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
     result.in_process_refused = run.value("in_process_refused", std::string());
     result.realtime_scheduling = run.value("realtime_scheduling", std::string());
     if (run.contains("board_io")) result.board_io = run.at("board_io");
+    if (run.contains("lateness")) result.rig_lateness = run.at("lateness");
     if (run.contains("emission_jitter")) {
         for (const nlohmann::json& device : run.at("emission_jitter")) {
             EmissionJitter jitter{device.at("device").get<std::string>(), device.at("samples").get<std::size_t>(),
@@ -444,6 +446,24 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
             figures.jitter.push_back(JitterRow{jitter.device, jitter.p50_ms, jitter.p99_ms, jitter.max_ms, jitter.step_max_ms});
         }
     }
+}
+
+// A real-time run whose own emissions passed the case's lateness bound cannot
+// judge the controller: its verdict is invalid (rig_overloaded), whatever the
+// controller did, unless the run already ended in something the lateness does
+// not explain (a stop signal, the rig's own error, a broken topic role).
+void apply_rig_overload(CaseResult& result) {
+    if (!result.rig_lateness.is_object()) return;
+    const std::string overloaded = result.rig_lateness.value("overloaded", std::string());
+    if (overloaded.empty()) return;
+    for (const char* kept : {"interrupted", "harness_error", "topic_role_violation"}) {
+        if (result.error_kind == kept) return;
+    }
+    std::string error = "the rig was overloaded: " + overloaded +
+                        "; the run cannot judge the controller (its metrics are reported, not judged)";
+    if (!result.error.empty()) error += "; the run also ended in " + result.error_kind + ": " + result.error;
+    result.error_kind = std::string(to_string(FailureKind::rig_overloaded));
+    result.error = std::move(error);
 }
 
 }  // namespace
@@ -491,6 +511,8 @@ CaseRun judge_trace(const RecordedTrace& trace) {
                 result.error = "node '" + violation->first + "': " + violation->second;
             }
         }
+
+        apply_rig_overload(result);
 
         MetricSet metrics;
         const VehicleTrack track(vehicle_samples(trace));

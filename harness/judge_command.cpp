@@ -169,7 +169,8 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
                                   : "re-judged: " + std::to_string(differing.size()) + " difference(s)\n");
     }
     if (!options.out_dir.empty()) out << "results: " << (options.out_dir / "results.json").string() << "\n";
-    return summary.failed == 0 && differing.empty() ? 0 : 1;
+    if (summary.failed > 0 || !differing.empty()) return 1;
+    return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
 }
 
 }  // namespace rig::harness

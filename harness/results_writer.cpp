@@ -53,6 +53,7 @@ std::string failure_metric(const std::string& failure) { return failure.substr(0
 bool is_missing_failure(const std::string& failure) { return failure.ends_with(kMissingSuffix); }
 
 std::string status_word(const CaseResult& result) {
+    if (case_invalid(result)) return "INVALID";
     if (!case_passed(result)) return "FAIL";
     return result.expected_failure ? "XFAIL-OK" : "PASS";
 }
@@ -236,6 +237,7 @@ TableRow make_row(const CaseResult& result, std::size_t metric_name_width) {
 const char* status_color(const std::string& status) {
     if (status == "PASS") return "\033[32m";
     if (status == "XFAIL-OK") return "\033[33m";
+    if (status == "INVALID") return "\033[1;35m";
     return "\033[1;31m";
 }
 constexpr const char* kColorFailure = "\033[31m";
@@ -386,11 +388,17 @@ bool case_passed(const CaseResult& result) {
     return result.passed;
 }
 
+bool case_invalid(const CaseResult& result) {
+    return result.error_kind == "rig_overloaded" && !case_passed(result);
+}
+
 RunSummary summarize(const std::vector<CaseResult>& results) {
     RunSummary summary;
     for (const CaseResult& result : results) {
         if (case_passed(result)) {
             ++summary.passed;
+        } else if (case_invalid(result)) {
+            ++summary.invalid;
         } else {
             ++summary.failed;
         }
@@ -417,6 +425,7 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"name", valid_utf8(result.name)},
             {"file", valid_utf8(result.file)},
             {"passed", case_passed(result)},
+            {"verdict", case_passed(result) ? "passed" : case_invalid(result) ? "invalid" : "failed"},
             {"expected_failure", result.expected_failure},
             {"expected_error", result.expected_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(result.expected_error)},
             {"seed", result.seed},
@@ -452,6 +461,7 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
                                     {"wiring", valid_utf8(result.wiring)},
                                     {"emission_jitter", std::move(jitter)}};
             if (!result.board_io.is_null()) one_case["realtime"]["board_io"] = result.board_io;
+            if (!result.rig_lateness.is_null()) one_case["realtime"]["rig_lateness"] = result.rig_lateness;
         }
         cases.push_back(std::move(one_case));
     }
@@ -463,7 +473,8 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
          {
              {"passed", summary.passed},
              {"failed", summary.failed},
-             {"total", summary.passed + summary.failed},
+             {"invalid", summary.invalid},
+             {"total", summary.passed + summary.failed + summary.invalid},
              {"sim_seconds", summary.sim_seconds},
              {"wall_seconds", summary.wall_seconds},
          }},
@@ -496,7 +507,9 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
     int failures = 0;
     int errors = 0;
     for (const CaseResult& result : results) {
-        if (case_passed(result)) continue;
+        // An invalid case (the rig was overloaded, the controller was not judged)
+        // is its suite's skipped test; <testsuites> has no count for those.
+        if (case_passed(result) || case_invalid(result)) continue;
         if (!result.error.empty()) {
             ++errors;
         } else {
@@ -512,13 +525,14 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
            format_fixed(summary.wall_seconds, 3) + "\">\n";
     for (const CaseResult& result : results) {
         const bool passed = case_passed(result);
-        const bool errored = !passed && !result.error.empty();
+        const bool invalid = case_invalid(result);
+        const bool errored = !passed && !invalid && !result.error.empty();
         const std::string time = format_fixed(result.wall_seconds, 3);
         const std::string folder = case_folder(result);
         xml += "  <testsuite name=\"" + xml_escape(result.name, true) + "\" package=\"" + xml_escape(folder, true) +
-               "\" tests=\"1\" failures=\"" + (passed || errored ? "0" : "1") + "\" errors=\"" + (errored ? "1" : "0") +
-               "\" skipped=\"0\" time=\"" + time + "\" timestamp=\"" + timestamp + "\" hostname=\"" +
-               xml_escape(hostname, true) + "\">\n";
+               "\" tests=\"1\" failures=\"" + (passed || errored || invalid ? "0" : "1") + "\" errors=\"" +
+               (errored ? "1" : "0") + "\" skipped=\"" + (invalid ? "1" : "0") + "\" time=\"" + time +
+               "\" timestamp=\"" + timestamp + "\" hostname=\"" + xml_escape(hostname, true) + "\">\n";
         xml += "    <properties>\n";
         xml += xml_property("seed", std::to_string(result.seed));
         if (!result.trace_sha256.empty()) xml += xml_property("trace_sha256", result.trace_sha256);
@@ -533,7 +547,10 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
         xml += "    </properties>\n";
         xml += "    <testcase classname=\"" + xml_escape(folder, true) + "\" name=\"" + xml_escape(result.name, true) +
                "\" time=\"" + time + "\">\n";
-        if (errored) {
+        if (invalid) {
+            // Not the controller's failure: the run could not judge it (docs/metrics.md "Verdicts").
+            xml += "      <skipped message=\"invalid: " + xml_escape(result.error, true) + "\"/>\n";
+        } else if (errored) {
             xml += "      <error type=\"" + xml_escape(result.error_kind.empty() ? "error" : result.error_kind, true) +
                    "\" message=\"" + xml_escape(result.error, true) + "\">" +
                    xml_escape(result.error + "\n" + join_lines(result.failures), false) + "</error>\n";
@@ -602,7 +619,9 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
     table += "\nsimulated " + format_fixed(summary.sim_seconds, 1) + " s in " + format_fixed(summary.wall_seconds, 1) +
              " s wall\n";
     // Kept alone on the last line: CI log readers look for "N passed, N failed".
-    table += std::to_string(summary.passed) + " passed, " + std::to_string(summary.failed) + " failed\n";
+    table += std::to_string(summary.passed) + " passed, " + std::to_string(summary.failed) + " failed" +
+             (summary.invalid > 0 ? ", " + std::to_string(summary.invalid) + " invalid (rig overloaded: not judged)" : "") +
+             "\n";
     return table;
 }
 
@@ -645,6 +664,7 @@ std::string result_details(const std::vector<CaseResult>& results) {
                 report += line;
             }
             if (!result.board_io.is_null()) report += "board I/O: " + board_io_summary(result.board_io) + "\n";
+            if (result.rig_lateness.is_object()) report += "rig lateness: " + rig_lateness_summary(result.rig_lateness) + "\n";
         }
     }
     return report;
@@ -669,6 +689,28 @@ std::vector<CaseResult> with_paths_relative_to(const std::filesystem::path& out_
 }
 
 }  // namespace
+
+std::string rig_lateness_summary(const nlohmann::json& lateness) {
+    try {
+        const nlohmann::json& bound = lateness.at("bound");
+        std::string line = "latest emission " + format_fixed(lateness.at("max_ms").get<double>(), 1) + " ms (" +
+                           valid_utf8(lateness.at("worst_device").get<std::string>()) + ", due at t = " +
+                           format_fixed(lateness.at("worst_at_s").get<double>(), 3) + " s); " +
+                           std::to_string(lateness.at("late").get<std::size_t>()) + " of " +
+                           std::to_string(lateness.at("emissions").get<std::size_t>()) + " emissions (" +
+                           format_fixed(lateness.at("late_pct").get<double>(), 2) + " %) more than " +
+                           format_g(bound.at("late_after_ms").get<double>(), 6) + " ms late; bound: at most " +
+                           format_g(bound.at("max_lateness_ms").get<double>(), 6) + " ms, at most " +
+                           format_g(bound.at("max_late_pct").get<double>(), 6) + " % late";
+        if (const nlohmann::json& stall = lateness.at("injected_stall"); stall.is_object()) {
+            line += "; self-test: the rig's loop was stalled " + format_g(stall.at("for_s").get<double>(), 6) +
+                    " s at t = " + format_g(stall.at("at_s").get<double>(), 6) + " s (rig_faults)";
+        }
+        return line;
+    } catch (const nlohmann::json::exception& error) {
+        return std::string("(malformed lateness record: ") + error.what() + ")";
+    }
+}
 
 void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
                    const RunSummary& summary) {

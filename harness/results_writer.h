@@ -54,6 +54,9 @@ struct CaseResult {
     // Real-time runs only: what scheduling the rig got, and the emission jitter per device.
     std::string realtime_scheduling;
     std::vector<EmissionJitter> emission_jitter;
+    // Real-time runs: the rig's own emission lateness against the case's bound
+    // (run facts `lateness`, harness/case_runner.cpp); null in lockstep.
+    nlohmann::json rig_lateness;
     // A Modbus board wire: frames per kind, fail-safe, attachment (harness/board_attach.h board_io_report).
     nlohmann::json board_io;
     std::string wiring;                 // e.g. "gnss serial /dev/pts/4, board_io modbus_rtu /dev/pts/6"
@@ -62,6 +65,7 @@ struct CaseResult {
 struct RunSummary {
     int passed = 0;
     int failed = 0;
+    int invalid = 0;  // rig overloaded: neither passed nor failed (case_invalid)
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
     // When the run started, UTC, "2026-11-24T12:05:09" (junit.xml's timestamp);
@@ -124,6 +128,10 @@ CaseVerdict judge_case(const VerdictInputs& inputs);
 
 // A case counts as passed only when `passed` is set and there is no error.
 bool case_passed(const CaseResult& result);
+// A case whose run cannot judge the controller: the rig's own lateness passed
+// the case's bound (error_kind rig_overloaded), and the case did not expect it.
+// Counted apart from passed and failed; `rig run` exits 3 when the rest passed.
+bool case_invalid(const CaseResult& result);
 
 // Counts and adds up the cases. wall_seconds is the sum of the cases' wall
 // times; a run with --jobs > 1 should overwrite it with its own elapsed time.
@@ -184,6 +192,10 @@ std::vector<std::string> write_results(const std::filesystem::path& out_dir, con
                                        const HtmlReportOptions& options);
 
 // ------------------------------------------------------------------ text and files (shared with html_report)
+
+// One line of a real-time run's own lateness (CaseResult::rig_lateness): the
+// latest emission, the late ones against the bound, an injected stall.
+std::string rig_lateness_summary(const nlohmann::json& lateness);
 
 // The text with malformed UTF-8 replaced by U+FFFD (nlohmann::json refuses to
 // dump invalid UTF-8, and error text may come from a crashed child's output).

@@ -22,6 +22,7 @@ namespace {
 constexpr std::chrono::milliseconds kRedrawInterval{250};
 
 std::string verdict_word(const CaseResult& result) {
+    if (case_invalid(result)) return "INVALID";
     if (!case_passed(result)) return "FAIL";
     return result.expected_failure ? "XFAIL-OK" : "PASS";
 }

@@ -33,6 +33,9 @@
 // board goes quiet on Modbus (a hung firmware task) while it keeps reading NMEA
 // and stays alive. Exit 0 when the rig closed the wires (the case ended), 1 on
 // an error.
+// Before libmodbus: its ON / OFF macros would break Fast DDS's headers behind realtime.h.
+#include "rig/runtime/realtime.h"
+
 #include <fcntl.h>
 #include <modbus/modbus.h>
 #include <unistd.h>
@@ -84,6 +87,7 @@ constexpr double kSectionOpenToLandingS = 0.27;
 
 // ---- This board's own choices.
 constexpr double kPollPeriodS = 0.02;
+constexpr int kBoardPriority = 30;  // SCHED_FIFO, below the rig's master (50) and wire threads (45)
 constexpr double kResetOpenS = 5.0;
 constexpr double kPumpAveragingFromS = 1.0;  // the pump's pulsation averaged over the rest of the reset
 // After the sections open or the valve moves, the pipeline settles (its time
@@ -197,6 +201,10 @@ public:
 
     // Returns when the rig has closed the wires (the case is over).
     void run() {
+        // A board's firmware runs on hardware of its own: the host's other work
+        // must not delay its polls, so this stand-in asks for real-time scheduling
+        // as the rig does (below the rig's threads).
+        std::cout << "board: scheduling " << rig::request_realtime_scheduling(kBoardPriority).detail << std::endl;
         started_s_ = now_s();
         while (!line_closed_) {
             read_nmea();

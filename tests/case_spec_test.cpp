@@ -618,15 +618,16 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
         "",           "field",       "field.origin",       "vehicle",    "boom",       "breakpoint",
         "gnss",       "gnss.noise",  "gnss.dropouts[0]",   "gnss.degraded[0]",       "encoder",
         "hydraulics", "hydraulics.valve", "hydraulics.flow_map", "flow_meter", "pump_sensor",
-        "boom_height_sensor",        "deposition",         "static_flow", "wiring",   "timeouts"};
+        "boom_height_sensor",        "deposition",         "static_flow", "wiring",   "timeouts",
+        "realtime",   "rig_faults"};
     const int ranged =
         expect_every_number_bounded(sections, [](const std::string& section, const std::string& key,
                                                  const std::string& value) {
             parse_case(minimal_with(section, key, value), "bounds.yaml");
         });
-    // The sweep found the keys, not an empty list: a case file has 76 numbers
+    // The sweep found the keys, not an empty list: a case file has 81 numbers
     // (a new one with a range changes this count; one without fails above).
-    EXPECT_EQ(ranged, 76);
+    EXPECT_EQ(ranged, 81);
     // Limits are data keys: their values are bounded too.
     for (const char* value : {"1e300", "-1e300"}) {
         EXPECT_THROW(parse_case(std::string(kMinimalCase) + "limits: { overlap_m: " + value + " }\n", "l.yaml"),
@@ -1011,6 +1012,69 @@ TEST(CaseSpec, BoardKeysParseWithDefaultsAndBounds) {
         } catch (const rig::ConfigError& error) {
             EXPECT_NE(std::string(error.what()).find("board"), std::string::npos) << error.what();
         }
+    }
+}
+
+// `realtime:` (harness/realtime_spec.h): the bound on the rig's own lateness;
+// `rig_faults:`: the self-test stall. Real-time cases only.
+TEST(CaseSpec, RealtimeLatenessKeysParseWithDefaultsAndBounds) {
+    const std::string realtime = std::string(kMinimalCase) + "mode: realtime\n";
+    const CaseSpec defaults = parse_case(realtime, "case.yaml");
+    EXPECT_EQ(defaults.realtime.late_after_ms, 10.0);
+    EXPECT_EQ(defaults.realtime.max_late_pct, 1.0);
+    EXPECT_EQ(defaults.realtime.max_lateness_ms, 100.0);
+    EXPECT_FALSE(defaults.rig_faults.has_value());
+    const CaseSpec set = parse_case(realtime +
+                                        "realtime: { late_after_ms: 5, max_late_pct: 0.5, max_lateness_ms: 40 }\n"
+                                        "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 0.5 }\n",
+                                    "case.yaml");
+    EXPECT_EQ(set.realtime.late_after_ms, 5.0);
+    EXPECT_EQ(set.realtime.max_late_pct, 0.5);
+    EXPECT_EQ(set.realtime.max_lateness_ms, 40.0);
+    ASSERT_TRUE(set.rig_faults.has_value());
+    EXPECT_EQ(set.rig_faults->master_stall_at_s, 3.0);
+    EXPECT_EQ(set.rig_faults->master_stall_for_s, 0.5);
+    struct Bad {
+        std::string text;
+        const char* key_path;
+        const char* message_part;
+    };
+    const std::vector<Bad> bad = {
+        {realtime + "realtime: { late_after_ms: 0 }\n", "realtime.late_after_ms", "must be"},
+        {realtime + "realtime: { max_late_pct: 101 }\n", "realtime.max_late_pct", "must be"},
+        {realtime + "realtime: { max_lateness_ms: 0.5 }\n", "realtime.max_lateness_ms", "must be"},
+        {realtime + "realtime: { late_after_ms: 50, max_lateness_ms: 20 }\n", "realtime.max_lateness_ms",
+         "is below late_after_ms"},
+        {realtime + "realtime: { late_after_ms: 500 }\n", "realtime.late_after_ms", "is below late_after_ms"},
+        {realtime + "realtime: { max_jitter_ms: 5 }\n", "realtime.max_jitter_ms", ""},
+        {realtime + "rig_faults: { master_stall_at_s: 3 }\n", "rig_faults.master_stall_for_s", ""},
+        {realtime + "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 0 }\n", "rig_faults.master_stall_for_s",
+         "must be"},
+        // Lockstep has no wall clock to be late on.
+        {std::string(kMinimalCase) + "realtime: { max_lateness_ms: 50 }\n", "realtime", "only with `mode: realtime`"},
+        {std::string(kMinimalCase) + "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 1 }\n", "rig_faults",
+         "only with `mode: realtime`"},
+    };
+    for (const Bad& one : bad) {
+        SCOPED_TRACE(one.text);
+        try {
+            parse_case(one.text, "case.yaml");
+            ADD_FAILURE() << "accepted";
+        } catch (const rig::ConfigError& error) {
+            EXPECT_EQ(error.key_path(), one.key_path) << error.what();
+            EXPECT_NE(error.message().find(one.message_part), std::string::npos) << error.what();
+        }
+    }
+    // The stall must fall within the case, as any timed event.
+    const CaseSpec stall = parse_case(realtime + "rig_faults: { master_stall_at_s: 30, master_stall_for_s: 1 }\n",
+                                      "case.yaml");
+    EXPECT_NO_THROW(check_case_timeline(stall, 60.0, 40.0));
+    try {
+        check_case_timeline(stall, 20.0, 10.0);
+        ADD_FAILURE() << "accepted a stall after the end";
+    } catch (const rig::ConfigError& error) {
+        EXPECT_EQ(error.key_path(), "rig_faults.master_stall_at_s") << error.what();
+        EXPECT_NE(error.message().find("after the case ends"), std::string::npos) << error.what();
     }
 }
 

@@ -251,6 +251,88 @@ TEST(Judge, AKilledControllersTraceKeepsItsSamplesAndItsError) {
         << result.failures.front();
 }
 
+// A real-time run's facts with the rig's own lateness (harness/case_runner.cpp
+// lateness_json): `overloaded` non-empty when it passed the case's bound.
+std::string realtime_run_facts(const std::string& overloaded) {
+    return nlohmann::json{{"wall_seconds", 61.0},
+                          {"lateness",
+                           {{"bound", {{"late_after_ms", 10.0}, {"max_late_pct", 1.0}, {"max_lateness_ms", 100.0}}},
+                            {"emissions", 20000},
+                            {"late", overloaded.empty() ? 0 : 7},
+                            {"late_pct", overloaded.empty() ? 0.0 : 0.035},
+                            {"max_ms", overloaded.empty() ? 1.2 : 500.4},
+                            {"worst_device", "gnss_g970"},
+                            {"worst_at_s", 33.0},
+                            {"first_late_device", nullptr},
+                            {"first_late_at_s", nullptr},
+                            {"devices", nlohmann::json::object()},
+                            {"injected_stall", nullptr},
+                            {"overloaded", overloaded}}}}
+        .dump();
+}
+
+// The controller that never resumes, recorded in a real-time run whose rig was
+// late: the missed metres may be the rig's, so the case is invalid, not failed;
+// the metrics are still there. The same behaviour with the rig on time fails.
+TEST(Judge, AnOverloadedRigMakesTheRunInvalidNotTheControllersFailure) {
+    const std::string overloaded = "gnss_g970 emitted 500.4 ms after its deadline at t = 33.000 s (bound "
+                                   "realtime.max_lateness_ms: 100 ms)";
+    for (const bool late : {true, false}) {
+        SCOPED_TRACE(late ? "overloaded" : "on time");
+        HandMadeTrace made(late ? "overloaded" : "on-time", continuation_plan());
+        made.trace().set_meta("mode", "realtime");
+        made.trace().set_meta("run", realtime_run_facts(late ? overloaded : ""));
+        made.drive();
+        made.section_command(0, 0);
+        made.breakpoint_reached(35 * kS);
+        made.hydraulics([](TimeNs) { return 0.0; }, [](TimeNs) { return false; });
+        made.spray(0, -24.5, 0.0);
+        made.finish();
+        const CaseResult result = made.judged().result;
+        EXPECT_FALSE(case_passed(result));
+        EXPECT_NEAR(result.metrics.at("missed_m"), 9.0, 1e-9) << "metrics are computed either way";
+        EXPECT_EQ(case_invalid(result), late);
+        if (late) {
+            EXPECT_EQ(result.error_kind, "rig_overloaded");
+            EXPECT_EQ(result.error, "the rig was overloaded: " + overloaded +
+                                        "; the run cannot judge the controller (its metrics are reported, not judged)");
+            EXPECT_FALSE(has_failure_starting(result, "missed_m")) << testing::PrintToString(result.failures);
+            EXPECT_EQ(result.rig_lateness.at("max_ms").get<double>(), 500.4);
+        } else {
+            EXPECT_EQ(result.error_kind, "");
+            EXPECT_TRUE(has_failure_starting(result, "missed_m 9 > 0")) << testing::PrintToString(result.failures);
+        }
+    }
+}
+
+// What the overload wins over, and what it does not: an error the controller
+// caused is kept in the text; a stop signal, the rig's own error and a broken
+// topic role are not the lateness's doing and stay as they are.
+TEST(Judge, TheOverloadWinsOverTheControllersErrorsButNotTheRigsOwn) {
+    const std::string overloaded = "plant emitted 300.0 ms after its deadline at t = 10.000 s";
+    const std::vector<std::pair<std::string, std::string>> ends = {
+        {"node_exited", "rig_overloaded"},      {"board_silent", "rig_overloaded"},
+        {"interrupted", "interrupted"},         {"harness_error", "harness_error"},
+        {"topic_role_violation", "topic_role_violation"}};
+    for (const auto& [ended, judged] : ends) {
+        SCOPED_TRACE(ended);
+        HandMadeTrace made("overloaded-" + ended, continuation_plan());
+        made.trace().set_meta("mode", "realtime");
+        made.trace().set_meta("run", realtime_run_facts(overloaded));
+        made.drive();
+        made.finish(TraceOutcome{ended == "interrupted" ? "interrupted" : "error", ended, "what happened", 20 * kS});
+        const CaseResult result = made.judged().result;
+        EXPECT_EQ(result.error_kind, judged);
+        EXPECT_FALSE(case_passed(result));
+        if (judged == "rig_overloaded") {
+            EXPECT_NE(result.error.find("; the run also ended in " + ended + ": what happened"), std::string::npos)
+                << result.error;
+        } else {
+            EXPECT_EQ(result.error, "what happened");
+        }
+    }
+}
+
 TEST(Judge, AnUnfinishedTraceIsReadableAsInterrupted) {
     const fs::path dir = rig::testing::fresh_dir("judge-unfinished");
     {

@@ -351,22 +351,31 @@ TEST(JunitXml, IsWellFormedAndEscaped) {
 
 // The same odd names and error text, against the schema Jenkins's xunit plugin
 // checks JUnit files with (xmllint from libxml2-utils, which scripts/setup installs).
+// xmllint's verdict on `text` against the Jenkins schema: "" when it validates, else what it said.
+std::string schema_problems(const std::string& text) {
+    const fs::path xml = fs::temp_directory_path() / ("results_writer_test_junit_" + std::to_string(::getpid()) + ".xml");
+    std::ofstream(xml) << text;
+    const std::string command = "xmllint --noout --schema '" RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd' '" +
+                                xml.string() + "' 2>&1";
+    std::string output;
+    int status = -1;
+    if (FILE* pipe = ::popen(command.c_str(), "r")) {
+        char buffer[512];
+        while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+        status = ::pclose(pipe);
+    }
+    fs::remove(xml);
+    const bool valid = WIFEXITED(status) && WEXITSTATUS(status) == 0 && output.find("validates") != std::string::npos;
+    return valid ? "" : "xmllint: " + output;
+}
+
 TEST(JunitXml, IsValidAgainstTheJenkinsSchema) {
     const std::vector<CaseResult> results = all_cases();
     RunSummary summary = summarize(results);
     summary.started_utc = "2026-11-24T12:05:09";
+    EXPECT_EQ(schema_problems(junit_xml(results, summary)), "");
     const fs::path xml = fs::temp_directory_path() / ("results_writer_test_junit_" + std::to_string(::getpid()) + ".xml");
     std::ofstream(xml) << junit_xml(results, summary);
-    const std::string command = "xmllint --noout --schema '" RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd' '" +
-                                xml.string() + "' 2>&1";
-    std::string output;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    ASSERT_NE(pipe, nullptr);
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
-    const int status = ::pclose(pipe);
-    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << output;
-    EXPECT_NE(output.find("validates"), std::string::npos) << output;
     std::ifstream written(xml);
     const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("timestamp=\"2026-11-24T12:05:09\""), std::string::npos) << text;
@@ -380,6 +389,105 @@ TEST(JunitXml, ChecksItsOwnChecker) {
     EXPECT_FALSE(is_well_formed_xml("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<a b=\"<\"></a>\n"));
     EXPECT_FALSE(is_well_formed_xml("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<a><b></a></b>\n"));
     EXPECT_TRUE(is_well_formed_xml("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<a b=\"&amp;\">&lt;<c/></a>\n"));
+}
+
+// ------------------------------------------------------------------ invalid: the rig overloaded
+
+// A real-time case whose rig passed its lateness bound (judge.cpp gives it
+// error_kind rig_overloaded): neither passed nor the controller's failure.
+CaseResult overloaded_case() {
+    CaseResult result;
+    result.name = "wired-6kmh";
+    result.file = "cases/wired.yaml";
+    result.mode = "realtime";
+    result.metrics = {{"missed_m", 4.0}};
+    result.limits = {{"missed_m", 0.0}};
+    result.error_kind = "rig_overloaded";
+    result.error = "the rig was overloaded: gnss_g970 emitted 153.2 ms after its deadline at t = 3.400 s";
+    const CaseVerdict verdict = judge_case(VerdictInputs{result.metrics, {}, result.limits, {}, "", result.error_kind,
+                                                         result.error});
+    result.passed = verdict.passed;
+    result.failures = verdict.failures;
+    result.rig_lateness = {{"bound", {{"late_after_ms", 10.0}, {"max_late_pct", 1.0}, {"max_lateness_ms", 100.0}}},
+                           {"emissions", 950},
+                           {"late", 3},
+                           {"late_pct", 0.316},
+                           {"max_ms", 153.2},
+                           {"worst_device", "gnss_g970"},
+                           {"worst_at_s", 3.4},
+                           {"injected_stall", nullptr},
+                           {"overloaded", "gnss_g970 emitted 153.2 ms after its deadline at t = 3.400 s"}};
+    return result;
+}
+
+TEST(Invalid, AnOverloadedRunIsNeitherPassedNorAControllerFailure) {
+    std::vector<CaseResult> results = all_cases();
+    results.push_back(overloaded_case());
+    EXPECT_FALSE(case_passed(results.back()));
+    EXPECT_TRUE(case_invalid(results.back()));
+    for (std::size_t i = 0; i + 1 < results.size(); ++i) EXPECT_FALSE(case_invalid(results[i])) << i;
+    const RunSummary summary = summarize(results);
+    EXPECT_EQ(summary.passed, 2);
+    EXPECT_EQ(summary.failed, 2);
+    EXPECT_EQ(summary.invalid, 1);
+
+    const nlohmann::json json = results_json(results, summary);
+    EXPECT_EQ(json["summary"]["invalid"], 1);
+    EXPECT_EQ(json["summary"]["total"], 5);
+    EXPECT_EQ(json["cases"][0]["verdict"], "passed");
+    EXPECT_EQ(json["cases"][1]["verdict"], "failed");
+    EXPECT_EQ(json["cases"][2]["verdict"], "failed");
+    EXPECT_EQ(json["cases"][3]["verdict"], "passed");
+    const nlohmann::json& invalid = json["cases"][4];
+    EXPECT_EQ(invalid["verdict"], "invalid");
+    EXPECT_EQ(invalid["passed"], false);
+    EXPECT_EQ(invalid["error_kind"], "rig_overloaded");
+    EXPECT_EQ(invalid["realtime"]["rig_lateness"]["worst_device"], "gnss_g970");
+    EXPECT_DOUBLE_EQ(invalid["realtime"]["rig_lateness"]["max_ms"].get<double>(), 153.2);
+
+    // junit.xml: skipped with the reason, counted neither as a failure nor as an error.
+    const std::string xml = junit_xml(results, summary);
+    EXPECT_TRUE(is_well_formed_xml(xml)) << xml;
+    EXPECT_NE(xml.find("<testsuites name=\"rig\" tests=\"5\" failures=\"1\" errors=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<testsuite name=\"wired-6kmh\" package=\"cases\" tests=\"1\" failures=\"0\" errors=\"0\" skipped=\"1\""),
+              std::string::npos)
+        << xml;
+    EXPECT_EQ(schema_problems(xml), "");
+    EXPECT_NE(xml.find("<skipped message=\"invalid: the rig was overloaded: gnss_g970 emitted 153.2 ms"),
+              std::string::npos)
+        << xml;
+
+    // The console: its own word, and a count of its own on the last line.
+    const std::string table = result_table(results, summary, /*color=*/false);
+    EXPECT_NE(table.find("wired-6kmh                 INVALID"), std::string::npos) << table;
+    EXPECT_TRUE(table.ends_with("\n2 passed, 2 failed, 1 invalid (rig overloaded: not judged)\n")) << table;
+    const std::string report = result_report(results, summary);
+    EXPECT_NE(report.find("rig lateness: latest emission 153.2 ms (gnss_g970, due at t = 3.400 s); 3 of 950 "
+                          "emissions (0.32 %) more than 10 ms late; bound: at most 100 ms, at most 1 % late"),
+              std::string::npos)
+        << report;
+}
+
+// A self-test case that exists to show the overload detection (expect: { error:
+// rig_overloaded }) passes when the rig was overloaded: it is not invalid.
+TEST(Invalid, ACaseExpectingTheOverloadPassesWithIt) {
+    CaseResult result = overloaded_case();
+    result.expected_error = "rig_overloaded";
+    const CaseVerdict verdict = judge_case(VerdictInputs{result.metrics, {}, result.limits, {}, result.expected_error,
+                                                         result.error_kind, result.error});
+    result.passed = verdict.passed;
+    EXPECT_TRUE(case_passed(result));
+    EXPECT_FALSE(case_invalid(result));
+    const RunSummary summary = summarize({result});
+    EXPECT_EQ(summary.passed, 1);
+    EXPECT_EQ(summary.invalid, 0);
+}
+
+// Without an overload, the last line keeps its form (CI log readers parse it).
+TEST(Invalid, TheLastLineIsUnchangedWithoutInvalidCases) {
+    const std::vector<CaseResult> results = all_cases();
+    EXPECT_TRUE(result_table(results, summarize(results), false).ends_with("\n2 passed, 2 failed\n"));
+    EXPECT_EQ(results_json(results, summarize(results))["summary"]["invalid"], 0);
 }
 
 // ------------------------------------------------------------------ table and files

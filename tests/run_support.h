@@ -1,4 +1,5 @@
 #pragma once
+#include <sys/wait.h>
 // Small helpers for the tests that run the `rig` executables as a user would
 // (whole runs, the network check, the negative cases).
 #include <gtest/gtest.h>
@@ -38,6 +39,23 @@ inline std::string read_all_command(const std::string& command) {
         ::pclose(pipe);
     }
     return output;
+}
+
+// A shell command's exit status and everything it printed on stdout (add
+// `2>&1` to the command for stderr too); exit_code -1 when it did not exit.
+struct ShellResult {
+    int exit_code = -1;
+    std::string output;
+};
+inline ShellResult run_shell(const std::string& command) {
+    ShellResult result;
+    if (FILE* pipe = ::popen(command.c_str(), "r")) {
+        char buffer[4096];
+        while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
+        const int status = ::pclose(pipe);
+        result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return result;
 }
 
 // Destinations in an strace log (sendto/sendmsg/connect lines as strace 6 prints them).

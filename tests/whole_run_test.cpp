@@ -204,6 +204,88 @@ TEST(WholeRun, WiredControllerInRealTimePassesThePapersLimits) {
     }
 }
 
+// The rig's own lateness (issue 14 item 5, docs/metrics.md "Verdicts"): the
+// short case in real time, once as it is and once with the rig's loop stalled
+// 0.5 s at t = 3 s (`rig_faults`, the overload detection's self-test). The
+// stall makes every 100 Hz device at least 490 ms late whatever the machine's
+// load, past the default 100 ms bound: the case is invalid (rig_overloaded),
+// not the controller's failure, in results.json, junit.xml, the reports and
+// the exit status (3). The idle run stays within the bound.
+std::string short_realtime_case(const fs::path& dir, const std::string& name, const std::string& extra) {
+    std::string text = read_all(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    const std::string name_line = "name: short-fusion";
+    const auto at = text.find(name_line);
+    text.replace(at, name_line.size(), "name: " + name);
+    text += "mode: realtime\n" + extra;
+    const fs::path file = dir / (name + ".yaml");
+    std::ofstream(file) << text;
+    return "'" + file.string() + "'";
+}
+
+TEST(WholeRun, RealTimeStallOfTheRigMakesTheCaseInvalidNotAControllerFailure) {
+    const fs::path dir = fresh_dir("rig-stall");
+    const std::string stalled =
+        short_realtime_case(dir, "stalled", "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 0.5 }\n");
+    const RunOutcome outcome = rig_run(stalled, dir / "out");
+    EXPECT_EQ(outcome.exit_code, 3) << outcome.log;
+    ASSERT_TRUE(outcome.results.contains("cases")) << outcome.log;
+    const nlohmann::json& result = outcome.results["cases"][0];
+    EXPECT_EQ(result["verdict"], "invalid") << result.dump(2);
+    EXPECT_FALSE(result["passed"].get<bool>());
+    EXPECT_EQ(result["error_kind"], "rig_overloaded");
+    const std::string error = result["error"].is_string() ? result["error"].get<std::string>() : "";
+    EXPECT_NE(error.find("the rig was overloaded: "), std::string::npos) << error;
+    EXPECT_NE(error.find("cannot judge the controller"), std::string::npos) << error;
+    EXPECT_EQ(outcome.results["summary"]["invalid"], 1);
+    EXPECT_EQ(outcome.results["summary"]["failed"], 0);
+    // The figures: how late, which device, when, and that the stall was injected.
+    const nlohmann::json& lateness = result["realtime"]["rig_lateness"];
+    EXPECT_GE(lateness["max_ms"].get<double>(), 490.0) << lateness.dump(2);
+    EXPECT_GE(lateness["worst_at_s"].get<double>(), 3.0) << lateness.dump(2);
+    EXPECT_GE(lateness["late"].get<int>(), 1);
+    EXPECT_NE(lateness["overloaded"].get<std::string>().find("realtime.max_lateness_ms: 100 ms"), std::string::npos)
+        << lateness.dump(2);
+    EXPECT_EQ(lateness["injected_stall"]["for_s"].get<double>(), 0.5);
+    // The metrics are still computed, for what they are worth.
+    EXPECT_TRUE(result["metrics"].contains("breakpoint_error_m")) << result.dump(2);
+    // junit.xml: skipped with the reason, not a failure or an error of the controller.
+    const std::string junit = read_all(dir / "out" / "junit.xml");
+    EXPECT_NE(junit.find("failures=\"0\" errors=\"0\" skipped=\"1\""), std::string::npos) << junit;
+    EXPECT_NE(junit.find("<skipped message=\"invalid: the rig was overloaded: "), std::string::npos) << junit;
+    // The console and the reports say so.
+    EXPECT_NE(outcome.log.find("rig: [INVALID] stalled"), std::string::npos) << outcome.log;
+    EXPECT_NE(outcome.log.find("0 passed, 0 failed, 1 invalid (rig overloaded: not judged)"), std::string::npos)
+        << outcome.log;
+    EXPECT_NE(read_all(dir / "out" / "report.txt").find("self-test: the rig's loop was stalled 0.5 s at t = 3 s"),
+              std::string::npos);
+    EXPECT_NE(read_all(dir / "out" / "report.html").find("Invalid: this run cannot judge the controller"),
+              std::string::npos);
+    // `rig judge` gives the same verdict from the trace alone.
+    const int status = std::system(("'" RIG_BINARY_DIR "/bin/rig' judge '" + (dir / "out").string() +
+                                    "' --check > '" + (dir / "judge.log").string() + "' 2>&1")
+                                       .c_str());
+    EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 3) << read_all(dir / "judge.log");
+    EXPECT_NE(read_all(dir / "judge.log").find("re-judged: every metric, verdict and digest as recorded"),
+              std::string::npos)
+        << read_all(dir / "judge.log");
+}
+
+TEST(WholeRun, RealTimeRunOfAnUnstalledRigIsNotInvalid) {
+    const fs::path dir = fresh_dir("rig-idle");
+    const RunOutcome outcome = rig_run(short_realtime_case(dir, "idle", ""), dir / "out");
+    ASSERT_TRUE(outcome.results.contains("cases")) << outcome.log;
+    const nlohmann::json& result = outcome.results["cases"][0];
+    EXPECT_NE(result["verdict"], "invalid") << result.dump(2);
+    EXPECT_NE(result["error_kind"], "rig_overloaded") << result.dump(2);
+    EXPECT_NE(outcome.exit_code, 3) << outcome.log;
+    // Its lateness was watched: every timed emission counted, none past the bound.
+    const nlohmann::json& lateness = result["realtime"]["rig_lateness"];
+    EXPECT_GT(lateness["emissions"].get<int>(), 1000) << lateness.dump(2);
+    EXPECT_EQ(lateness["overloaded"], "") << lateness.dump(2);
+    EXPECT_TRUE(lateness["injected_stall"].is_null());
+    EXPECT_EQ(outcome.results["summary"]["invalid"], 0);
+}
+
 // A GNSS line on a pseudo-terminal that a board opened but never reads: the
 // rig must not stream into it for the whole case (it used to end after the
 // case's wall-time bound with "simulated 0.0 s" and an empty trace), but fail

@@ -19,6 +19,7 @@ constexpr std::pair<FailureKind, std::string_view> kFailureKindNames[] = {
     {FailureKind::harness_error, "harness_error"},
     {FailureKind::board_not_attached, "board_not_attached"},
     {FailureKind::board_silent, "board_silent"},
+    {FailureKind::rig_overloaded, "rig_overloaded"},
 };
 }  // namespace
 

@@ -23,6 +23,8 @@ enum class FailureKind {
     harness_error,         // the rig itself failed (a trace it cannot write, a bad wire...)
     board_not_attached,    // an external board did not attach to its wires within board.attach_timeout_s
     board_silent,          // the board's Modbus master sent no valid request for board.silence_timeout_s
+    rig_overloaded,        // real time: the rig's own emissions passed the case's lateness bound (realtime:);
+                           // the run is invalid, it cannot judge the controller (docs/metrics.md "Verdicts")
 };
 std::string_view to_string(FailureKind kind);
 // The kind with this name; nullopt for an unknown one.

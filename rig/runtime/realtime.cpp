@@ -1,5 +1,6 @@
 #include "rig/runtime/realtime.h"
 
+#include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
@@ -54,6 +55,14 @@ SchedulingReport request_realtime_scheduling(int priority) {
     return report;
 }
 
+std::string raise_thread_to_realtime(std::thread& thread, int priority) {
+    if (!thread.joinable()) return "no thread";
+    sched_param param{};
+    param.sched_priority = priority;
+    const int error = pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
+    return error == 0 ? std::string() : std::string("SCHED_FIFO refused: ") + std::strerror(error);
+}
+
 RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), remotes_(dds, timeouts) {}
 
 RealtimeMaster::~RealtimeMaster() { shutdown(); }
@@ -80,13 +89,22 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
     if (!started_) throw std::logic_error("RealtimeMaster::run_until before start");
     for (;;) {
         const std::uint64_t arrivals_seen = dds_.arrival_count();
+        if (clock_.now_ns() >= stall_at_ns_) {
+            stall_at_ns_ = kNever;
+            clock_.sleep_until_ns(clock_.now_ns() + stall_for_ns_);
+        }
         const TimeNs now = clock_.now_ns();
         if (now >= end_ns) return;
         for (Local& local : locals_) {
             if (local.next_wake_ns <= now) {
-                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
-                if (local.next_wake_ns > 0) local.late_ns.push_back(now - local.next_wake_ns);
+                // Late by when its step began: a long step of a node before it in
+                // this pass delays its emission too.
                 const TimeNs step_started_ns = clock_.now_ns();
+                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
+                if (local.next_wake_ns > 0) {
+                    local.late_ns.push_back(step_started_ns - local.next_wake_ns);
+                    lateness_.record(local.node->name(), local.next_wake_ns, step_started_ns);
+                }
                 local.next_wake_ns = local.node->step(now);
                 local.step_ns.push_back(clock_.now_ns() - step_started_ns);
             } else if (local.node->has_unread_input()) {

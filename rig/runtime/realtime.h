@@ -21,10 +21,12 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "rig/runtime/clock.h"
 #include "rig/runtime/dds_context.h"
+#include "rig/runtime/lateness.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/runtime/node.h"
 
@@ -56,6 +58,10 @@ struct SchedulingReport {
 // and the run goes on without it. Also sets the timer slack to 1 ns, so
 // deadline waits are not rounded up by the kernel's default 50 us.
 SchedulingReport request_realtime_scheduling(int priority);
+// SCHED_FIFO at `priority` for another, already running thread (a wire's
+// server or forwarder: threads started before request_realtime_scheduling()
+// do not inherit it). "" when granted, else why not.
+std::string raise_thread_to_realtime(std::thread& thread, int priority);
 
 class RealtimeMaster {
 public:
@@ -90,6 +96,17 @@ public:
     const RealtimeClock& clock() const { return clock_; }
     // Per local node (by name): how late its timed wake-ups were.
     std::map<std::string, JitterStats> emission_jitter() const;
+    // Every timed emission of the local nodes against `bound` (rig/runtime/lateness.h):
+    // whether the rig kept time well enough for the run to judge the controller.
+    void set_lateness_bound(LatenessBound bound) { lateness_.set_bound(bound); }
+    LatenessVerdict lateness() const { return lateness_.verdict(); }
+    // Self-test of the overload detection (a case's `rig_faults:`): the first
+    // pass at or after `at_ns` blocks for `for_ns` before stepping anything, as
+    // a machine that took the rig's CPU away would. Never used to judge a controller.
+    void inject_stall(TimeNs at_ns, TimeNs for_ns) {
+        stall_at_ns_ = at_ns;
+        stall_for_ns_ = for_ns;
+    }
 
 private:
     struct Local {
@@ -102,6 +119,9 @@ private:
     LockstepMaster remotes_;
     RealtimeClock clock_;
     std::vector<Local> locals_;
+    LatenessAccount lateness_;
+    TimeNs stall_at_ns_ = kNever;
+    TimeNs stall_for_ns_ = 0;
     std::function<void(TimeNs)> after_step_;
     std::function<void()> watchdog_;
     bool started_ = false;

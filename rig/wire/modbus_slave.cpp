@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "rig/runtime/clock.h"
+#include "rig/runtime/realtime.h"
 
 namespace rig::modbus {
 namespace {
@@ -221,6 +222,11 @@ public:
 
     static void check_failsafe_options(const CommsFailsafe& failsafe) {
         if (failsafe.timeout.count() < 0) throw std::invalid_argument("Modbus fail-safe timeout must be >= 0 ms (0 = off)");
+    }
+
+    std::string raise_to_realtime(int priority) {
+        std::lock_guard stop_lock(stop_mutex_);
+        return raise_thread_to_realtime(thread_, priority);
     }
 
     void stop() {
@@ -787,5 +793,6 @@ std::optional<std::chrono::nanoseconds> ModbusSlave::since_last_request() const 
 bool ModbusSlave::failsafe_active() const { return impl_->failsafe_active(); }
 std::optional<std::string> ModbusSlave::server_failure() const { return impl_->server_failure(); }
 void ModbusSlave::stop() { impl_->stop(); }
+std::string ModbusSlave::raise_to_realtime(int priority) { return impl_->raise_to_realtime(priority); }
 
 }  // namespace rig::modbus

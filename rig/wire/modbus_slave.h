@@ -153,6 +153,11 @@ public:
     // no more); the message says what. Never set in normal operation.
     std::optional<std::string> server_failure() const;
 
+    // SCHED_FIFO at `priority` for the serving thread (real-time runs: the
+    // master's answers must not wait for the machine's other work). "" when
+    // granted, else why not.
+    std::string raise_to_realtime(int priority);
+
     // Stops serving and closes the port; bounded time, idempotent. Must not be
     // called from a callback.
     void stop();

@@ -1,5 +1,7 @@
 #include "rig/wire/pty_pair.h"
 
+#include "rig/runtime/realtime.h"
+
 #include <sys/ioctl.h>
 
 #include <fcntl.h>
@@ -102,6 +104,8 @@ PtyLink::~PtyLink() {
     stop();
     if (wake_fd_ >= 0) ::close(wake_fd_);
 }
+
+std::string PtyLink::raise_to_realtime(int priority) { return raise_thread_to_realtime(forwarder_, priority); }
 
 void PtyLink::stop() {
     if (!forwarder_.joinable()) return;

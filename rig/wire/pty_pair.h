@@ -82,6 +82,9 @@ public:
     const std::string& slave_path_a() const { return a_.slave_path(); }
     const std::string& slave_path_b() const { return b_.slave_path(); }
 
+    // SCHED_FIFO at `priority` for the forwarding thread (every byte crosses
+    // it). "" when granted, else why not.
+    std::string raise_to_realtime(int priority);
     // Stops the forwarding thread (it wakes at once; bounded) and joins it.
     // Bytes still inside the rig are dropped, as on a cable pulled mid-byte.
     void stop();
