@@ -17,6 +17,7 @@
 #include <map>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <unistd.h>
 
 #include "harness/nmea_decode_tool.h"
@@ -25,6 +26,7 @@
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
 #include "harness/build_info.h"
+#include "harness/shard.h"
 #include "harness/trace_mcap.h"
 #include "harness/case_runner.h"
 #include "harness/case_world.h"
@@ -48,7 +50,7 @@ std::filesystem::path own_directory() {
 }
 
 int run_command(const std::vector<std::string>& inputs, const rig::harness::RunOptions& options,
-                rig::harness::Verbosity verbosity) {
+                const std::optional<rig::harness::Shard>& shard, rig::harness::Verbosity verbosity) {
     using namespace rig::harness;
     std::vector<CaseSpec> specs;
     try {
@@ -86,6 +88,21 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
             for (const auto& error : errors) std::cerr << "rig: " << error << "\n";
             std::cerr << "rig: " << errors.size() << " case file error(s); nothing was run\n";
             return 2;
+        }
+        // Every file was checked above, whichever shard it is in: a broken case fails every shard's job.
+        if (shard) {
+            const std::size_t all = specs.size();
+            // Moved into a new vector, never assigned over each other: a CaseSpec
+            // holds yaml-cpp nodes, whose assignment writes through to the node
+            // they refer to (std::erase_if shifted one case's controller section
+            // onto its neighbour's).
+            std::vector<CaseSpec> kept;
+            for (CaseSpec& spec : specs) {
+                if (in_shard(spec.name, *shard)) kept.push_back(std::move(spec));
+            }
+            specs = std::move(kept);
+            std::cerr << "rig: shard " << shard->index << "/" << shard->count << ": " << specs.size() << " of " << all
+                      << " cases (join the shards' outputs with rig merge)\n";
         }
     } catch (const std::exception& error) {
         std::cerr << "rig: " << error.what() << "\n";
@@ -254,6 +271,10 @@ int main(int argc, char** argv) {
     auto* domain_option =
         run->add_option("--domain", domain, "run every case on this DDS domain (one case at a time), e.g. for an observer")
             ->check(CLI::Range(0, 232));
+    std::string shard_text;
+    auto* shard_option = run->add_option(
+        "--shard", shard_text,
+        "I/N: run only shard I of N of the cases (by name, stable), e.g. one job of a CI matrix; rig merge joins them");
     run->add_flag("--in-process", run_options.in_process,
                   "software-in-the-loop: run each lockstep case's controller from its plugin inside the rig's process "
                   "(a case's controller.in_process wins; others run as processes, saying why)");
@@ -272,6 +293,12 @@ int main(int argc, char** argv) {
     judge->add_option("--out", judge_options.out_dir, "write results.json, junit.xml and the reports here");
     judge->add_flag("--check", judge_options.check,
                     "compare with each directory's results.json: metrics, verdicts and digests must be the same");
+
+    rig::harness::MergeCommandOptions merge_options;
+    auto* merge = app.add_subcommand(
+        "merge", "join the outputs of rig run --shard I/N into one run directory (results.json, junit.xml, reports)");
+    merge->add_option("shard_outs", merge_options.shard_dirs, "the shards' rig run --out directories")->required();
+    merge->add_option("--out", merge_options.out_dir, "the merged run directory (new or empty)")->required();
 
     auto* nmea = app.add_subcommand("nmea", "NMEA tools");
     nmea->require_subcommand(1);
@@ -333,12 +360,22 @@ int main(int argc, char** argv) {
             }
             run_options.domain = domain;
         }
+        std::optional<rig::harness::Shard> shard;
+        if (shard_option->count() > 0) {
+            try {
+                shard = rig::harness::parse_shard(shard_text);
+            } catch (const std::invalid_argument& error) {
+                std::cerr << "rig run: " << error.what() << "\n";
+                return 2;
+            }
+        }
         const auto verbosity = run_quiet     ? rig::harness::Verbosity::quiet
                                : run_verbose ? rig::harness::Verbosity::verbose
                                              : rig::harness::Verbosity::normal;
-        return run_command(case_inputs, run_options, verbosity);
+        return run_command(case_inputs, run_options, shard, verbosity);
     }
     if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);
+    if (merge->parsed()) return rig::harness::run_merge_command(merge_options, std::cout, std::cerr);
     if (decode->parsed()) return nmea_decode_command(nmea_input);
     if (modbus_serve->parsed()) return rig::harness::run_modbus_serve_command(modbus_serve_options);
     if (bench->parsed()) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -171,6 +172,86 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
     if (!options.out_dir.empty()) out << "results: " << (options.out_dir / "results.json").string() << "\n";
     if (summary.failed > 0 || !differing.empty()) return 1;
     return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
+}
+
+int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std::ostream& err) {
+    struct Shard {
+        fs::path dir;
+        nlohmann::json results;
+        std::vector<fs::path> case_dirs;
+    };
+    std::vector<Shard> shards;
+    try {
+        if (options.out_dir.empty()) throw std::runtime_error("--out DIR is required");
+        if (fs::exists(options.out_dir) && !(fs::is_directory(options.out_dir) && fs::is_empty(options.out_dir))) {
+            throw std::runtime_error(options.out_dir.string() + " exists and is not an empty directory");
+        }
+        std::map<std::string, fs::path> shard_of_case;
+        for (const std::string& argument : options.shard_dirs) {
+            Shard shard{argument, {}, {}};
+            if (!fs::is_directory(shard.dir)) throw std::runtime_error(argument + ": not a rig run --out directory");
+            shard.results = read_json(shard.dir / "results.json");
+            for (const Input& input : traces_of_run(shard.dir)) {
+                const fs::path case_dir = input.trace.parent_path();
+                const std::string name = case_dir.filename().string();
+                const auto [earlier, inserted] = shard_of_case.emplace(name, shard.dir);
+                if (!inserted) {
+                    throw std::runtime_error("case " + name + " is in both " + earlier->second.string() + " and " +
+                                             shard.dir.string() + ": not shards of one suite");
+                }
+                shard.case_dirs.push_back(case_dir);
+            }
+            shards.push_back(std::move(shard));
+        }
+    } catch (const std::exception& error) {
+        err << "rig merge: " << error.what() << "\n";
+        return 2;
+    }
+
+    std::vector<CaseResult> results;
+    std::vector<CaseFigures> figures;
+    std::vector<std::string> differing;
+    try {
+        fs::create_directories(options.out_dir / "cases");
+        for (const Shard& shard : shards) {
+            for (const fs::path& case_dir : shard.case_dirs) {
+                const fs::path copy = options.out_dir / "cases" / case_dir.filename();
+                fs::copy(case_dir, copy, fs::copy_options::recursive);
+                CaseRun run = judge_trace(read_trace(copy / "trace.sqlite"));
+                const nlohmann::json* before = nullptr;
+                for (const nlohmann::json& one : shard.results.at("cases")) {
+                    if (one.at("name") == run.result.name) before = &one;
+                }
+                if (before == nullptr) {
+                    differing.push_back(run.result.name + ": not in " + (shard.dir / "results.json").string());
+                } else {
+                    for (std::string& difference : differences(run.result, *before)) differing.push_back(std::move(difference));
+                }
+                results.push_back(std::move(run.result));
+                figures.push_back(std::move(run.figures));
+            }
+        }
+    } catch (const std::exception& error) {
+        err << "rig merge: " << error.what() << "\n";
+        return 2;
+    }
+    RunSummary summary = summarize(results);
+    try {
+        for (const std::string& problem : write_results(options.out_dir, results, summary, figures, HtmlReportOptions{})) {
+            err << "rig merge: report: " << problem << "\n";
+        }
+    } catch (const std::exception& error) {
+        err << "rig merge: cannot write the results in " << options.out_dir.string() << ": " << error.what() << "\n";
+        return 2;
+    }
+    out << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    for (const std::string& difference : differing) out << "differs: " << difference << "\n";
+    out << "merged " << results.size() << " cases from " << shards.size() << " shards; "
+        << (differing.empty() ? "every metric, verdict and digest as the shards recorded\n"
+                              : std::to_string(differing.size()) + " difference(s) from the shards\n");
+    out << "results: " << (options.out_dir / "results.json").string() << "\n";
+    if (summary.failed > 0 || !differing.empty()) return 1;
+    return summary.invalid > 0 ? 3 : 0;
 }
 
 }  // namespace rig::harness

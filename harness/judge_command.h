@@ -26,4 +26,18 @@ struct JudgeCommandOptions {
 
 int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err);
 
+// `rig merge SHARD_OUT... --out DIR`: the outputs of `rig run --shard I/N`
+// joined into one run directory, as one `rig run` of all the cases would have
+// written it: every shard's cases/NAME/ copied into DIR/cases/, each trace
+// judged again and checked against its shard's results.json (every metric,
+// verdict and digest), then DIR's results.json, junit.xml and reports. A case
+// name found in two shards, a shard without results.json, or a DIR that is not
+// new or empty are refused before anything is written (exit 2). Exit as
+// `rig run`: 1 if a case failed or differs from its shard, 3 if only invalid.
+struct MergeCommandOptions {
+    std::vector<std::string> shard_dirs;
+    std::filesystem::path out_dir;
+};
+int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std::ostream& err);
+
 }  // namespace rig::harness

@@ -110,6 +110,29 @@ vehicle:
   start_m: -60
 )";
 
+// Cases move about in vectors (a shard's selection, sorting): assigning one
+// case's kept YAML over another's must not write into the nodes a third copy
+// still shares (yaml-cpp's Node::operator= does), nor lose its own.
+TEST(RawYaml, AssignmentTakesTheOthersNodeAndLeavesCopiesAlone) {
+    RawYaml first{YAML::Load("target_flow_l_min: 15"), {}, true};
+    const RawYaml copy_of_first = first;
+    const RawYaml second{YAML::Load("target_flow_l_min: 17"), {}, true};
+    first = second;
+    EXPECT_EQ(first.node["target_flow_l_min"].as<int>(), 17);
+    EXPECT_EQ(copy_of_first.node["target_flow_l_min"].as<int>(), 15);
+    EXPECT_EQ(second.node["target_flow_l_min"].as<int>(), 17);
+
+    std::vector<RawYaml> sections = {RawYaml{YAML::Load("n: 1"), {}, true}, RawYaml{YAML::Load("n: 2"), {}, true},
+                                     RawYaml{YAML::Load("n: 3"), {}, true}};
+    const std::vector<RawYaml> before = sections;
+    std::erase_if(sections, [](const RawYaml& section) { return section.node["n"].as<int>() == 1; });
+    ASSERT_EQ(sections.size(), 2u);
+    EXPECT_EQ(sections[0].node["n"].as<int>(), 2);
+    EXPECT_EQ(sections[1].node["n"].as<int>(), 3);
+    EXPECT_EQ(before[0].node["n"].as<int>(), 1);
+    EXPECT_EQ(before[1].node["n"].as<int>(), 2);
+}
+
 TEST(CaseSpec, FullFileParsesToTheWrittenValues) {
     TempDir dir;
     const fs::path file = dir.write("full.yaml", kFullCase);

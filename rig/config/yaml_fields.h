@@ -94,6 +94,23 @@ struct RawYaml {
     YAML::Node node;  // a null node when absent: check `present`
     SourceLocation location;
     bool present = false;
+
+    RawYaml() = default;
+    RawYaml(YAML::Node node_, SourceLocation location_, bool present_)
+        : node(std::move(node_)), location(std::move(location_)), present(present_) {}
+    RawYaml(const RawYaml&) = default;
+    RawYaml(RawYaml&&) = default;
+    RawYaml& operator=(RawYaml&& other) { return *this = static_cast<const RawYaml&>(other); }
+    // Assignment takes the other's node, as a value would. yaml-cpp's own
+    // Node::operator= writes the right side into the node the left one refers
+    // to, which every copy of it shares: moving cases about in a vector then
+    // gave one case the controller section of its neighbour.
+    RawYaml& operator=(const RawYaml& other) {
+        node.reset(other.node);
+        location = other.location;
+        present = other.present;
+        return *this;
+    }
 };
 
 class YamlSection {
