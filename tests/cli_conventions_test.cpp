@@ -84,7 +84,7 @@ TEST(CliConventions, UsageErrorsNameTheBadWordAndExit2) {
         std::string args;
         std::string says;
     } errors[] = {
-        {"rnu", "rig: unknown command 'rnu' (did you mean 'run'? commands: run, judge, nmea, "},
+        {"rnu", "rig: unknown command 'rnu' (did you mean 'run'? commands: run, judge, "},
         {"", "rig: missing command (commands: run, judge, "},
         {"--frob", "rig: unknown option '--frob'"},
         {"run --frob x.yaml", "rig run: unknown option '--frob'"},
