@@ -8,6 +8,7 @@
 #   lib/cmake/rig/rigConfig.cmake (+ version, targets)       find_package(rig)
 #   bin/rig, bin/rig-controller                              the harness and the reference controller (full build)
 #   lib/rig/rig-controller-plugin.so                         the reference controller as a plugin (rig run --in-process)
+#   share/bash-completion/completions/rig                    bash completion for `rig` (scripts/rig-completion.bash)
 include(CMakePackageConfigHelpers)
 
 install(TARGETS rig_runtime rig_idl rig_nmea EXPORT rigTargets
@@ -39,4 +40,7 @@ if(TARGET rig AND TARGET rig-controller)
   install(TARGETS rig rig-controller RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   # The reference controller as a plugin, where `rig` looks for it (lib/rig/ beside bin/).
   install(TARGETS rig-controller-plugin LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/rig)
+  # Where bash-completion looks for a command's completion when it is first completed.
+  install(FILES ${PROJECT_SOURCE_DIR}/scripts/rig-completion.bash
+          DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions RENAME rig)
 endif()

@@ -24,6 +24,7 @@
 #include "harness/case_session.h"
 #include "harness/case_world.h"
 #include "harness/run_interrupt.h"
+#include "harness/run_progress.h"
 #include "harness/trace_recorder.h"
 #include "harness/wire_fault_report.h"
 #include "idl/topics.h"
@@ -113,10 +114,12 @@ std::string describe_signal(int signal) {
 class Watchdog {
 public:
     Watchdog(const CaseSpec& spec, const WallStopwatch& wall, DdsContext& dds, TraceRecorder& trace,
-             CaseSession& session, const TimeNs& now_ns)
-        : spec_(spec), wall_(wall), dds_(dds), trace_(trace), session_(session), now_ns_(now_ns) {}
+             CaseSession& session, const TimeNs& now_ns, CaseClock* clock)
+        : spec_(spec), wall_(wall), dds_(dds), trace_(trace), session_(session), now_ns_(now_ns), clock_(clock) {}
 
     void operator()() {
+        // Called after every round and in every wait slice: the case's clock for a progress display.
+        if (clock_ != nullptr) clock_->now_ns.store(now_ns_, std::memory_order_relaxed);
         if (const int signal = run_interrupt_signal()) {
             throw NodeFailure(FailureKind::interrupted, "harness", describe_signal(signal));
         }
@@ -159,6 +162,7 @@ private:
     TraceRecorder& trace_;
     CaseSession& session_;
     const TimeNs& now_ns_;
+    CaseClock* clock_;
 };
 
 // Topics the controller said in its hello it writes that the rig has no type
@@ -456,7 +460,8 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         RunFacts facts;
         facts.controller_mode = session.controller_mode();
         facts.in_process_refused = in_process_refused;
-        Watchdog watchdog(spec, wall, dds, trace, session, now_ns);
+        if (options.clock != nullptr) options.clock->end_ns.store(world.end_ns, std::memory_order_relaxed);
+        Watchdog watchdog(spec, wall, dds, trace, session, now_ns, options.clock);
         const TraceOutcome outcome = session.run_to_outcome(
             [&] {
                 if (spec.mode == RunMode::lockstep) {
@@ -503,25 +508,27 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 }
 
 std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress) {
+    CaseLineLog observer(progress, Verbosity::normal);
+    return run_cases(specs, options, observer);
+}
+
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer) {
     const std::vector<CaseInstance> instances = expand_runs(specs, options);
     std::vector<CaseRun> runs(instances.size());
-    std::mutex progress_mutex;
+    observer.runs_planned(instances, specs);
     auto run_one = [&](std::size_t i) {
         const CaseInstance& instance = instances[i];
         const CaseSpec& spec = specs[instance.spec_index];
+        observer.case_started(i);
         if (const int signal = run_interrupt_signal()) {
             runs[i] = unstarted_run(spec, instance.seed, instance.name, FailureKind::interrupted,
                                     "not run: " + describe_signal(signal) + " before it started", 0.0);
         } else {
-            runs[i] = run_case(spec, instance.seed, instance.name, options);
+            RunOptions case_options = options;
+            case_options.clock = observer.case_clock(i);
+            runs[i] = run_case(spec, instance.seed, instance.name, case_options);
         }
-        const CaseResult& result = runs[i].result;
-        std::lock_guard lock(progress_mutex);
-        progress << "rig: ["
-                 << (case_passed(result)    ? (result.expected_failure ? "XFAIL-OK" : "PASS")
-                     : case_invalid(result) ? "INVALID"
-                                            : "FAIL")
-                 << "] " << result.name << " (" << result.wall_seconds << " s wall)\n";
+        observer.case_finished(i, runs[i].result);
     };
     // Lockstep cases share the machine; a real-time case runs alone, after them,
     // so that other cases' load does not become its scheduling jitter.

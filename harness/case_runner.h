@@ -7,6 +7,7 @@
 //   the judge      harness/judge.h         verdict, metrics and figures from the trace alone
 // A case that fails, errs or is interrupted keeps its trace up to that moment,
 // with the reason in the trace's meta table, and is judged from it like any other.
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -18,6 +19,13 @@
 #include "harness/judge.h"
 
 namespace rig::harness {
+
+// A running case's simulated time and its end, published by its runner for a
+// progress display to read from another thread (0: not known yet).
+struct CaseClock {
+    std::atomic<TimeNs> now_ns{0};
+    std::atomic<TimeNs> end_ns{0};
+};
 
 struct RunOptions {
     std::filesystem::path out_dir = "rig-out";
@@ -34,6 +42,9 @@ struct RunOptions {
     // `rig run --in-process`: every case whose controller can runs in process
     // (a case's own controller.in_process wins).
     bool in_process = false;
+    // Where run_case publishes the case's clock as it runs (a progress display);
+    // nullptr: nowhere. run_cases sets it per case from its RunObserver.
+    CaseClock* clock = nullptr;
 };
 
 // Checks that need more than the file itself (e.g. the reference controller's
@@ -56,10 +67,26 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 // The same with the case's own seed (or --seed) and name.
 CaseRun run_case(const CaseSpec& spec, const RunOptions& options);
 
+// What run_cases tells while it runs (harness/run_progress.h shows it as lines
+// or on a terminal's status line). runs_planned comes first, on the calling
+// thread; the others come from the thread running that case, so may overlap.
+class RunObserver {
+public:
+    virtual ~RunObserver() = default;
+    // Every run, in expand_runs() order (the indexes below), and their case files.
+    virtual void runs_planned(const std::vector<CaseInstance>& runs, const std::vector<CaseSpec>& specs) = 0;
+    virtual void case_started(std::size_t index) = 0;
+    virtual void case_finished(std::size_t index, const CaseResult& result) = 0;
+    // Where the run `index` publishes its clock; nullptr: nobody reads it.
+    virtual CaseClock* case_clock(std::size_t index) = 0;
+};
+
 // Runs every expanded case `options.jobs` at a time (real-time cases alone,
-// after the others), printing one progress line per case. After SIGINT /
+// after the others), telling `observer` as cases start and end. After SIGINT /
 // SIGTERM (harness/run_interrupt.h) the running cases end as interrupted and
 // the rest are reported as not run.
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer);
+// The same, printing one progress line per case as it ends (harness/run_progress.h CaseLineLog).
 std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress);
 
 }  // namespace rig::harness

@@ -1,5 +1,6 @@
 // `rig`: the rig's one command line (README "Running cases", `rig --help`).
-//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process] [--domain N]
+//   rig --version
+//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process] [--domain N] [--quiet | --verbose]
 //   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--out DIR]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
@@ -7,11 +8,15 @@
 //   rig modbus serve [--tcp ADDRESS:PORT | --rtu DEVICE ...] [synthetic signal options]
 //   rig emulate gnss CASE [--port DEVICE | --pty] [--baud N]
 //   rig pty [...], rig hid list [...]
+// A usage error (unknown command or option, missing or bad value) names the
+// word at fault and exits 2; `rig --version` prints the version and commit.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <unistd.h>
 
@@ -21,6 +26,7 @@
 #include "harness/cli_checks.h"
 #include "harness/bench_modbus.h"
 #include "harness/bench_serial.h"
+#include "harness/build_info.h"
 #include "harness/shard.h"
 #include "harness/trace_mcap.h"
 #include "harness/case_runner.h"
@@ -30,6 +36,7 @@
 #include "harness/output_dir.h"
 #include "harness/results_writer.h"
 #include "harness/run_interrupt.h"
+#include "harness/run_progress.h"
 #include "rig/runtime/clock.h"
 #include "rig/config/config_error.h"
 #include "harness/speed_bench.h"
@@ -46,7 +53,7 @@ std::filesystem::path own_directory() {
 }
 
 int run_command(const std::vector<std::string>& inputs, const rig::harness::RunOptions& options,
-                const std::optional<rig::harness::Shard>& shard) {
+                const std::optional<rig::harness::Shard>& shard, rig::harness::Verbosity verbosity) {
     using namespace rig::harness;
     std::vector<CaseSpec> specs;
     try {
@@ -121,7 +128,20 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     // what ran are still written (harness/run_interrupt.h).
     install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
-    const auto runs = run_cases(specs, options, std::cerr);
+    const std::string started_utc = rig::utc_date_time_now();
+    // Progress on standard error: a status line kept up to date on a terminal,
+    // a line per case elsewhere (a CI log); nothing with --quiet.
+    std::unique_ptr<RunObserver> observer;
+    TerminalProgress* terminal = nullptr;
+    if (verbosity != Verbosity::quiet && isatty(STDERR_FILENO) != 0) {
+        auto progress = std::make_unique<TerminalProgress>(std::cerr, verbosity, options.jobs, terminal_width(STDERR_FILENO));
+        terminal = progress.get();
+        observer = std::move(progress);
+    } else {
+        observer = std::make_unique<CaseLineLog>(std::cerr, verbosity);
+    }
+    const auto runs = run_cases(specs, options, *observer);
+    if (terminal != nullptr) terminal->finish();
     std::vector<CaseResult> results;
     std::vector<CaseFigures> figures;
     for (const CaseRun& run : runs) {
@@ -130,6 +150,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     }
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
+    summary.started_utc = started_utc;
     // A disk that filled during the run: the table still goes to the terminal,
     // the failure is told, never an abort (harness/output_dir.h).
     std::vector<std::string> report_problems;
@@ -139,7 +160,21 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     } catch (const std::exception& error) {
         results_problem = error.what();
     }
-    std::cout << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    if (verbosity == Verbosity::quiet) {
+        // What went wrong and the count, nothing else.
+        for (const CaseResult& result : results) {
+            if (case_passed(result)) continue;
+            std::cout << (case_invalid(result) ? "INVALID " : "FAIL ") << result.name << ": "
+                      << (result.failures.empty() || case_invalid(result) ? result.error : result.failures.front())
+                      << "\n";
+        }
+        // The table's last line: "N passed, M failed" (and how many were invalid).
+        const std::string table = result_table(results, summary, /*color=*/false);
+        std::cout << table.substr(table.rfind('\n', table.size() - 2) + 1);
+    } else {
+        std::cout << result_table(results, summary, colour_wanted(STDOUT_FILENO));
+        if (verbosity == Verbosity::verbose) std::cout << result_details(results);
+    }
     for (const std::string& problem : report_problems) std::cerr << "rig: report: " << problem << "\n";
     if (!results_problem.empty()) {
         std::cerr << "rig: results not written: " << results_problem << "\n";
@@ -149,9 +184,11 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         }
         return kExitResultsNotWritten;
     }
-    std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
-              << (options.out_dir / "report.txt").string() << ", " << (options.out_dir / "report.html").string()
-              << "\n";
+    if (verbosity != Verbosity::quiet) {
+        std::cout << "results: " << (options.out_dir / "results.json").string() << ", report: "
+                  << (options.out_dir / "report.txt").string() << ", " << (options.out_dir / "report.html").string()
+                  << "\n";
+    }
     if (const int signal = run_interrupt_signal()) {
         std::cerr << "rig: interrupted by signal " << signal << "; the cases that ran are in the results\n";
         return 128 + signal;
@@ -167,11 +204,87 @@ int nmea_decode_command(const std::string& input) {
     return rig::nmea::decode_file(input, std::cout, std::cerr);
 }
 
+// Edit distance, for "did you mean" on a mistyped command.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t above = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+// A usage error as one line naming the word at fault, then exit status 2 (the
+// shell convention for a command used wrongly; CLI11's own codes are 1xx).
+// Help and --version are not errors: CLI11 prints them and they exit 0.
+int usage_error(const CLI::App& app, const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return app.exit(error);
+    // The command the error is in: the deepest subcommand that was reached.
+    const CLI::App* command = &app;
+    std::string path = "rig";
+    for (bool deeper = true; deeper;) {
+        deeper = false;
+        for (const CLI::App* sub : command->get_subcommands([](const CLI::App*) { return true; })) {
+            if (sub->parsed()) {
+                command = sub;
+                path += " " + sub->get_name();
+                deeper = true;
+                break;
+            }
+        }
+    }
+    std::vector<std::string> commands;
+    for (const CLI::App* sub : command->get_subcommands([](const CLI::App*) { return true; })) {
+        if (!sub->get_group().empty()) commands.push_back(sub->get_name());
+    }
+    std::vector<std::string> extras = app.remaining(/*recurse=*/true);
+    std::string message;
+    const bool needs_command = !commands.empty() && command->get_require_subcommand_min() > 0 &&
+                               dynamic_cast<const CLI::RequiredError*>(&error) != nullptr;
+    if (needs_command || dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr) {
+        const auto word = std::find_if(extras.begin(), extras.end(), [](const std::string& w) { return !w.empty(); });
+        std::string list;
+        for (const std::string& name : commands) list += (list.empty() ? "" : ", ") + name;
+        if (word == extras.end()) {
+            message = "missing command (commands: " + list + ")";
+        } else if (word->front() == '-') {
+            message = "unknown option '" + *word + "' (" + path + " --help lists the options)";
+        } else if (needs_command) {
+            std::string suggestion;
+            for (const std::string& name : commands) {
+                if (edit_distance(*word, name) <= 2) {
+                    suggestion = "did you mean '" + name + "'? ";
+                    break;
+                }
+            }
+            message = "unknown command '" + *word + "' (" + suggestion + "commands: " + list + ")";
+        } else {
+            message = "unexpected argument '" + *word + "' (" + path + " --help says what it takes)";
+        }
+    } else {
+        // CLI11's text names the option or argument: "--jobs: Value 99 not in
+        // range 1 to 16", "--out: 1 required TEXT missing", "cases is required".
+        message = std::string(error.what()) + " (" + path + " --help)";
+    }
+    std::cerr << path << ": " << message << "\n";
+    return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"Sprayer HIL rig: runs timed cases against a controller under test and judges them from truth"};
     app.require_subcommand(1);
+    app.set_version_flag("--version",
+                         "rig " + std::string(rig::harness::rig_version()) + " (commit " +
+                             std::string(rig::harness::rig_commit()) + ")",
+                         "print the rig's version and the commit it was built from, and exit");
 
     rig::harness::RunOptions run_options;
     run_options.controller_executable = own_directory() / "rig-controller";
@@ -196,6 +309,13 @@ int main(int argc, char** argv) {
     run->add_flag("--in-process", run_options.in_process,
                   "software-in-the-loop: run each lockstep case's controller from its plugin inside the rig's process "
                   "(a case's controller.in_process wins; others run as processes, saying why)");
+    bool run_quiet = false;
+    bool run_verbose = false;
+    auto* quiet_flag = run->add_flag("--quiet,-q", run_quiet,
+                                     "print only the failed cases and the count: no progress, no table");
+    auto* verbose_flag = run->add_flag("--verbose,-v", run_verbose,
+                                       "also print each case as it starts, and every case's details after the table");
+    quiet_flag->excludes(verbose_flag);
 
     rig::harness::JudgeCommandOptions judge_options;
     auto* judge = app.add_subcommand(
@@ -253,7 +373,11 @@ int main(int argc, char** argv) {
     modbus->require_subcommand(1);
     auto* modbus_serve = rig::harness::add_modbus_serve_subcommand(*modbus, modbus_serve_options);
 
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        return usage_error(app, error);
+    }
     if (pty_bench.parsed()) return pty_bench.run();
     if (hid_bench.parsed()) return hid_bench.run();
     if (emulate_bench.parsed()) return emulate_bench.run();
@@ -276,7 +400,10 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
-        return run_command(case_inputs, run_options, shard);
+        const auto verbosity = run_quiet     ? rig::harness::Verbosity::quiet
+                               : run_verbose ? rig::harness::Verbosity::verbose
+                                             : rig::harness::Verbosity::normal;
+        return run_command(case_inputs, run_options, shard, verbosity);
     }
     if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);
     if (merge->parsed()) return rig::harness::run_merge_command(merge_options, std::cout, std::cerr);

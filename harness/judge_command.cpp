@@ -12,6 +12,7 @@
 
 #include "harness/judge.h"
 #include "harness/results_writer.h"
+#include "harness/run_progress.h"
 
 namespace rig::harness {
 
@@ -162,7 +163,7 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
             return 2;
         }
     }
-    out << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    out << result_table(results, summary, colour_wanted(STDOUT_FILENO));
     if (options.check) {
         for (const std::string& difference : differing) out << "differs: " << difference << "\n";
         out << (differing.empty() ? "re-judged: every metric, verdict and digest as recorded\n"

@@ -14,7 +14,9 @@
 #include <system_error>
 
 #include "harness/board_io_report.h"
+#include "harness/build_info.h"
 #include "harness/html_report.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::harness {
 
@@ -464,6 +466,8 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
         cases.push_back(std::move(one_case));
     }
     return {
+        {"schema_version", kResultsSchemaVersion},
+        {"rig", {{"version", std::string(rig_version())}, {"commit", std::string(rig_commit())}}},
         {"cases", std::move(cases)},
         {"summary",
          {
@@ -477,52 +481,99 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
     };
 }
 
+namespace {
+
+// JUnit's classname: the folder the case file is in ("cases/table2-flow-adjust/x.yaml"
+// gives "table2-flow-adjust"), which is how a suite's cases are grouped; "rig"
+// for a case file named without a folder.
+std::string case_folder(const CaseResult& result) {
+    const std::string folder = std::filesystem::path(result.file).parent_path().filename().string();
+    return folder.empty() || folder == "." || folder == ".." ? std::string("rig") : folder;
+}
+
+std::string this_hostname() {
+    char name[256] = {};
+    if (gethostname(name, sizeof name - 1) != 0) return "unknown";
+    return name;
+}
+
+std::string xml_property(const std::string& name, const std::string& value) {
+    return "        <property name=\"" + xml_escape(name, true) + "\" value=\"" + xml_escape(value, true) + "\"/>\n";
+}
+
+}  // namespace
+
 std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& summary) {
     int failures = 0;
     int errors = 0;
-    int skipped = 0;  // invalid: the rig was overloaded, the controller was not judged
     for (const CaseResult& result : results) {
-        if (case_passed(result)) continue;
-        if (case_invalid(result)) {
-            ++skipped;
-        } else if (!result.error.empty()) {
+        // An invalid case (the rig was overloaded, the controller was not judged)
+        // is its suite's skipped test; <testsuites> has no count for those.
+        if (case_passed(result) || case_invalid(result)) continue;
+        if (!result.error.empty()) {
             ++errors;
         } else {
             ++failures;
         }
     }
-    const std::string counts = " tests=\"" + std::to_string(results.size()) + "\" failures=\"" +
-                               std::to_string(failures) + "\" errors=\"" + std::to_string(errors) + "\" skipped=\"" +
-                               std::to_string(skipped) + "\"";
-    const std::string run_time = format_fixed(summary.wall_seconds, 3);
+    const std::string timestamp = summary.started_utc.empty() ? utc_date_time_now() : summary.started_utc;
+    const std::string hostname = this_hostname();
 
     std::string xml = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    xml += "<testsuites name=\"rig\"" + counts + " time=\"" + run_time + "\">\n";
-    xml += "  <testsuite name=\"rig\"" + counts + " time=\"" + run_time + "\">\n";
+    xml += "<testsuites name=\"rig\" tests=\"" + std::to_string(results.size()) + "\" failures=\"" +
+           std::to_string(failures) + "\" errors=\"" + std::to_string(errors) + "\" time=\"" +
+           format_fixed(summary.wall_seconds, 3) + "\">\n";
     for (const CaseResult& result : results) {
-        xml += "    <testcase classname=\"rig\" name=\"" + xml_escape(result.name, true) + "\" file=\"" +
-               xml_escape(result.file, true) + "\" time=\"" + format_fixed(result.wall_seconds, 3) + "\">\n";
-        if (case_invalid(result)) {
+        const bool passed = case_passed(result);
+        const bool invalid = case_invalid(result);
+        const bool errored = !passed && !invalid && !result.error.empty();
+        const std::string time = format_fixed(result.wall_seconds, 3);
+        const std::string folder = case_folder(result);
+        xml += "  <testsuite name=\"" + xml_escape(result.name, true) + "\" package=\"" + xml_escape(folder, true) +
+               "\" tests=\"1\" failures=\"" + (passed || errored || invalid ? "0" : "1") + "\" errors=\"" +
+               (errored ? "1" : "0") + "\" skipped=\"" + (invalid ? "1" : "0") + "\" time=\"" + time +
+               "\" timestamp=\"" + timestamp + "\" hostname=\"" + xml_escape(hostname, true) + "\">\n";
+        xml += "    <properties>\n";
+        xml += xml_property("seed", std::to_string(result.seed));
+        if (!result.trace_sha256.empty()) xml += xml_property("trace_sha256", result.trace_sha256);
+        if (!result.trace_path.empty()) xml += xml_property("trace_path", result.trace_path);
+        xml += xml_property("mode", result.mode);
+        if (!result.controller_mode.empty()) xml += xml_property("controller_mode", result.controller_mode);
+        xml += xml_property("case_file", result.file);
+        xml += xml_property("verdict", status_word(result));
+        xml += xml_property("expected_failure", result.expected_failure ? "true" : "false");
+        xml += xml_property("rig_version", std::string(rig_version()));
+        xml += xml_property("rig_commit", std::string(rig_commit()));
+        xml += "    </properties>\n";
+        xml += "    <testcase classname=\"" + xml_escape(folder, true) + "\" name=\"" + xml_escape(result.name, true) +
+               "\" time=\"" + time + "\">\n";
+        if (invalid) {
             // Not the controller's failure: the run could not judge it (docs/metrics.md "Verdicts").
             xml += "      <skipped message=\"invalid: " + xml_escape(result.error, true) + "\"/>\n";
-        } else if (!result.error.empty() && !case_passed(result)) {
+        } else if (errored) {
             xml += "      <error type=\"" + xml_escape(result.error_kind.empty() ? "error" : result.error_kind, true) +
                    "\" message=\"" + xml_escape(result.error, true) + "\">" +
                    xml_escape(result.error + "\n" + join_lines(result.failures), false) + "</error>\n";
-        } else if (!case_passed(result)) {
+        } else if (!passed) {
             const std::string headline =
                 result.failures.empty() ? std::string("case failed") : result.failures.front();
             xml += "      <failure type=\"limit\" message=\"" + xml_escape(headline, true) + "\">" +
                    xml_escape(join_lines(result.failures), false) + "</failure>\n";
         }
-        std::string output = "seed: " + std::to_string(result.seed) + "\n";
-        if (result.expected_failure) output += "expected failures: " + join_lines(result.failures);
+        std::string output;
+        if (passed && result.expected_failure) {
+            // JUnit has no expected failure: the case passes, and says why here.
+            output += "XFAIL-OK: an expected failure: the case's expect: asked for exactly this outcome\n" +
+                      join_lines(result.failures);
+        }
+        output += "seed: " + std::to_string(result.seed) + "\n";
         if (!result.trace_sha256.empty()) output += "trace: " + result.trace_path + " sha256 " + result.trace_sha256 + "\n";
         output += metrics_text(result);
         xml += "      <system-out>" + xml_escape(output, false) + "</system-out>\n";
         xml += "    </testcase>\n";
+        xml += "  </testsuite>\n";
     }
-    xml += "  </testsuite>\n</testsuites>\n";
+    xml += "</testsuites>\n";
     return xml;
 }
 
@@ -575,7 +626,11 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
 }
 
 std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary) {
-    std::string report = result_table(results, summary, /*color=*/false);
+    return result_table(results, summary, /*color=*/false) + result_details(results);
+}
+
+std::string result_details(const std::vector<CaseResult>& results) {
+    std::string report;
     for (const CaseResult& result : results) {
         report += "\n== " + result.name + " (" + result.file + ")\n";
         report += "result: " + status_word(result) + "   seed: " + std::to_string(result.seed) +
@@ -615,6 +670,26 @@ std::string result_report(const std::vector<CaseResult>& results, const RunSumma
     return report;
 }
 
+namespace {
+
+// `path` as seen from `base`: CI archives the output folder, so what its files
+// name must be found from where they are, not from where the rig ran.
+std::string path_relative_to(const std::filesystem::path& path, const std::filesystem::path& base) {
+    std::error_code error;
+    const std::filesystem::path relative = std::filesystem::relative(path, base, error);
+    if (!error && !relative.empty()) return relative.generic_string();
+    return std::filesystem::absolute(path).lexically_relative(std::filesystem::absolute(base)).generic_string();
+}
+
+std::vector<CaseResult> with_paths_relative_to(const std::filesystem::path& out_dir, std::vector<CaseResult> results) {
+    for (CaseResult& result : results) {
+        if (!result.trace_path.empty()) result.trace_path = path_relative_to(result.trace_path, out_dir);
+    }
+    return results;
+}
+
+}  // namespace
+
 std::string rig_lateness_summary(const nlohmann::json& lateness) {
     try {
         const nlohmann::json& bound = lateness.at("bound");
@@ -640,11 +715,12 @@ std::string rig_lateness_summary(const nlohmann::json& lateness) {
 void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
                    const RunSummary& summary) {
     std::filesystem::create_directories(out_dir);
+    const std::vector<CaseResult> relative = with_paths_relative_to(out_dir, results);
     const std::string json_text =
-        results_json(results, summary).dump(2) + "\n";
+        results_json(relative, summary).dump(2) + "\n";
     write_file_atomically(out_dir / "results.json", json_text);
-    write_file_atomically(out_dir / "junit.xml", junit_xml(results, summary));
-    write_file_atomically(out_dir / "report.txt", result_report(results, summary));
+    write_file_atomically(out_dir / "junit.xml", junit_xml(relative, summary));
+    write_file_atomically(out_dir / "report.txt", result_report(relative, summary));
 }
 
 std::vector<std::string> write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
@@ -654,7 +730,8 @@ std::vector<std::string> write_results(const std::filesystem::path& out_dir, con
     // The human report is a view: whatever goes wrong with it is told, never a
     // reason to fail (or crash) a run whose results are already written.
     try {
-        return write_html_report(out_dir / "report.html", results, figures, summary, options);
+        return write_html_report(out_dir / "report.html", with_paths_relative_to(out_dir, results), figures, summary,
+                                 options);
     } catch (const std::exception& error) {
         return {std::string("report.html not written: ") + error.what()};
     }

@@ -68,7 +68,15 @@ struct RunSummary {
     int invalid = 0;  // rig overloaded: neither passed nor failed (case_invalid)
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
+    // When the run started, UTC, "2026-11-24T12:05:09" (junit.xml's timestamp);
+    // empty: junit_xml() takes the time it is written.
+    std::string started_utc;
 };
+
+// results.json's "schema_version". 1 was the unversioned form, whose
+// trace_path was the path the run wrote to; from 2 on it is relative to the
+// folder results.json is in (the --out directory), and "rig" says which rig wrote it.
+inline constexpr int kResultsSchemaVersion = 2;
 
 // ------------------------------------------------------------------ judging
 
@@ -131,17 +139,27 @@ RunSummary summarize(const std::vector<CaseResult>& results);
 
 // ------------------------------------------------------------------ outputs
 
-// The docs/design.md contract: {"cases": [{name, passed, seed, metrics, limits,
+// The docs/design.md contract: {"schema_version": 2, "rig": {version, commit},
+// "cases": [{name, passed, seed, metrics, limits,
 // failures, trace_sha256, + file, expected_failure, error (null when none),
 // trace_path, sim_seconds, wall_seconds}], "summary": {passed, failed,
 // sim_seconds, wall_seconds, + total}}. NaN metrics become null; malformed
-// UTF-8 in any string is replaced by U+FFFD, so dump() never throws.
+// UTF-8 in any string is replaced by U+FFFD, so dump() never throws. Paths are
+// written as the results hold them: write_results() makes them relative to its folder.
 nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary);
 
-// JUnit XML (one <testsuite name="rig">, one <testcase> per case): a failed case
-// has <failure message="first failure"> with every failure in its text; a case
-// with an error has <error> instead. Metrics and seed go in <system-out>.
-// Text is XML-escaped, invalid UTF-8 and characters XML 1.0 forbids are replaced.
+// JUnit XML, valid against Jenkins xunit's JUnit schema (tests/data/jenkins-junit-10.xsd):
+// <testsuites> with one <testsuite> per case (that schema allows properties on a
+// suite only), named like the case, with the run's timestamp, the hostname and
+// the case's properties (seed, trace_sha256, trace_path, mode, controller_mode,
+// case_file, verdict, expected_failure, rig_version, rig_commit), holding the
+// case's one <testcase> whose classname is the case file's folder
+// ("table2-flow-adjust"). A failed case has <failure message="first failure">
+// with every failure in its text; a case with an error has <error> instead. The
+// schema has no expected failure: such a case passes, its suite's property
+// expected_failure is true and its <system-out> begins "XFAIL-OK". Metrics and
+// seed go in <system-out>. Text is XML-escaped, invalid UTF-8 and characters XML
+// 1.0 forbids are replaced.
 std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& summary);
 
 // The terminal table: case | PASS / FAIL / XFAIL-OK | limited metrics as
@@ -151,10 +169,13 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
 
 // The table followed by per-case details (file, seed, trace, all metrics, error).
 std::string result_report(const std::vector<CaseResult>& results, const RunSummary& summary);
+// The per-case details alone (`rig run --verbose` prints them after the table).
+std::string result_details(const std::vector<CaseResult>& results);
 
 // Writes out_dir/results.json, junit.xml and report.txt (creating out_dir),
 // each through a temporary file renamed into place, so a reader never sees a
-// half-written file. Throws std::runtime_error / std::filesystem::filesystem_error.
+// half-written file. Trace paths in them are relative to out_dir (CI archives
+// that folder, and the paths must still point at the traces there). Throws std::runtime_error / std::filesystem::filesystem_error.
 void write_results(const std::filesystem::path& out_dir, const std::vector<CaseResult>& results,
                    const RunSummary& summary);
 

@@ -3,7 +3,10 @@
 #include "harness/results_writer.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdio>
 
 #include <cmath>
 #include <fstream>
@@ -204,6 +207,9 @@ TEST(ResultsJson, MatchesTheDesignContract) {
     const std::vector<CaseResult> results = all_cases();
     const nlohmann::json json = results_json(results, summarize(results));
 
+    EXPECT_EQ(json["schema_version"], kResultsSchemaVersion);
+    EXPECT_TRUE(json["rig"]["version"].is_string());
+    EXPECT_TRUE(json["rig"]["commit"].is_string());
     ASSERT_TRUE(json.contains("cases"));
     ASSERT_TRUE(json["cases"].is_array());
     ASSERT_EQ(json["cases"].size(), 4u);
@@ -322,10 +328,10 @@ TEST(JunitXml, IsWellFormedAndEscaped) {
     const std::string xml = junit_xml(results, summarize(results));
     EXPECT_TRUE(is_well_formed_xml(xml)) << xml;
 
-    EXPECT_NE(xml.find("<testsuite name=\"rig\" tests=\"4\" failures=\"1\" errors=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<testsuites name=\"rig\" tests=\"4\" failures=\"1\" errors=\"1\""), std::string::npos) << xml;
     // The name `overlap-<&"'>` in an attribute.
     EXPECT_NE(xml.find("name=\"overlap-&lt;&amp;&quot;&apos;&gt;\""), std::string::npos) << xml;
-    EXPECT_NE(xml.find("file=\"cases/a&amp;b.yaml\""), std::string::npos);
+    EXPECT_NE(xml.find("<property name=\"case_file\" value=\"cases/a&amp;b.yaml\"/>"), std::string::npos);
     EXPECT_NE(xml.find("<failure type=\"limit\" message=\"breakpoint_error_m missing\">breakpoint_error_m missing\n"
                        "overlap_m 3.61 &gt; 3.3\n</failure>"),
               std::string::npos)
@@ -341,6 +347,41 @@ TEST(JunitXml, IsWellFormedAndEscaped) {
         ++testcases;
     }
     EXPECT_EQ(testcases, 4u);
+}
+
+// The same odd names and error text, against the schema Jenkins's xunit plugin
+// checks JUnit files with (xmllint from libxml2-utils, which scripts/setup installs).
+// xmllint's verdict on `text` against the Jenkins schema: "" when it validates, else what it said.
+std::string schema_problems(const std::string& text) {
+    const fs::path xml = fs::temp_directory_path() / ("results_writer_test_junit_" + std::to_string(::getpid()) + ".xml");
+    std::ofstream(xml) << text;
+    const std::string command = "xmllint --noout --schema '" RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd' '" +
+                                xml.string() + "' 2>&1";
+    std::string output;
+    int status = -1;
+    if (FILE* pipe = ::popen(command.c_str(), "r")) {
+        char buffer[512];
+        while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+        status = ::pclose(pipe);
+    }
+    fs::remove(xml);
+    const bool valid = WIFEXITED(status) && WEXITSTATUS(status) == 0 && output.find("validates") != std::string::npos;
+    return valid ? "" : "xmllint: " + output;
+}
+
+TEST(JunitXml, IsValidAgainstTheJenkinsSchema) {
+    const std::vector<CaseResult> results = all_cases();
+    RunSummary summary = summarize(results);
+    summary.started_utc = "2026-11-24T12:05:09";
+    EXPECT_EQ(schema_problems(junit_xml(results, summary)), "");
+    const fs::path xml = fs::temp_directory_path() / ("results_writer_test_junit_" + std::to_string(::getpid()) + ".xml");
+    std::ofstream(xml) << junit_xml(results, summary);
+    std::ifstream written(xml);
+    const std::string text((std::istreambuf_iterator<char>(written)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("timestamp=\"2026-11-24T12:05:09\""), std::string::npos) << text;
+    // The classname is the case file's folder.
+    EXPECT_NE(text.find("<testcase classname=\"cases\" name=\"plant-dies\""), std::string::npos) << text;
+    fs::remove(xml);
 }
 
 TEST(JunitXml, ChecksItsOwnChecker) {
@@ -407,7 +448,11 @@ TEST(Invalid, AnOverloadedRunIsNeitherPassedNorAControllerFailure) {
     // junit.xml: skipped with the reason, counted neither as a failure nor as an error.
     const std::string xml = junit_xml(results, summary);
     EXPECT_TRUE(is_well_formed_xml(xml)) << xml;
-    EXPECT_NE(xml.find("tests=\"5\" failures=\"1\" errors=\"1\" skipped=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<testsuites name=\"rig\" tests=\"5\" failures=\"1\" errors=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<testsuite name=\"wired-6kmh\" package=\"cases\" tests=\"1\" failures=\"0\" errors=\"0\" skipped=\"1\""),
+              std::string::npos)
+        << xml;
+    EXPECT_EQ(schema_problems(xml), "");
     EXPECT_NE(xml.find("<skipped message=\"invalid: the rig was overloaded: gnss_g970 emitted 153.2 ms"),
               std::string::npos)
         << xml;

@@ -323,8 +323,9 @@ TEST(WholeRun, AGnssLineNobodyReadsFailsAtOnceNamingThePort) {
     // bound plus start-up is far below it, even on a loaded machine.
     EXPECT_LT(wall_s, 11.0);
     EXPECT_GT(result["sim_seconds"].get<double>(), 1.0) << "it ran until the line was found unread";
+    // trace_path is relative to the run's --out folder (docs/design.md "Results").
     const std::string trace = result["trace_path"];
-    EXPECT_TRUE(fs::exists(trace)) << trace;
+    EXPECT_TRUE(fs::exists(out / trace)) << trace;
 }
 
 // SIGINT (Ctrl-C) or SIGTERM during `rig run`: the running case ends as

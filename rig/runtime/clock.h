@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <string>
 
 namespace rig {
 
@@ -69,5 +70,10 @@ private:
 // discovery record, a pty's far end being opened): start-up and bench waits,
 // never inside a lockstep round. Outside rig/, this is the way to wait.
 void pause_between_polls(std::chrono::milliseconds interval);
+
+// Today's date and time in UTC as "2026-11-24T12:05:09" (ISO 8601 without a
+// zone, the form JUnit XML's timestamp takes): a label for a run's reports,
+// never an input to it.
+std::string utc_date_time_now();
 
 }  // namespace rig
