@@ -114,6 +114,10 @@ TEST(ShardAndMerge, TheMergedShardsAreTheSuiteRunAtOnce) {
         EXPECT_TRUE(fs::exists(dir / "merged" / "cases" / name / "trace.sqlite"));
     }
     for (const char* file : {"junit.xml", "report.txt", "report.html"}) EXPECT_TRUE(fs::exists(dir / "merged" / file)) << file;
+    // The merged junit.xml is CI-grade like a run's (ci_outputs_test holds the run's).
+    const auto schema = run_shell("xmllint --noout --schema " + quoted(RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd") +
+                                  " " + quoted(dir / "merged" / "junit.xml") + " 2>&1");
+    EXPECT_EQ(schema.exit_code, 0) << schema.output;
 }
 
 TEST(ShardAndMerge, MergesThatCannotBeRightAreRefusedBeforeWriting) {

@@ -76,8 +76,9 @@ TEST(WireFaultsCase, ReferenceControllerRejectsEveryCorruptSentenceAndOnlyTheByt
     EXPECT_EQ(off.at("trace_sha256"), absent.at("trace_sha256"));
     EXPECT_NE(faulty.at("trace_sha256"), off.at("trace_sha256"));
 
-    const auto faulty_trace = rig::harness::read_trace(faulty.at("trace_path").get<std::string>());
-    const auto off_trace = rig::harness::read_trace(off.at("trace_path").get<std::string>());
+    // trace_path is relative to the run's --out folder (docs/design.md "Results").
+    const auto faulty_trace = rig::harness::read_trace(dir / "faulty" / faulty.at("trace_path").get<std::string>());
+    const auto off_trace = rig::harness::read_trace(dir / "off" / off.at("trace_path").get<std::string>());
     // The truth is the route's, whatever the wire did: equal at every instant
     // both traces sampled it (the 20 Hz grid; the extra samples at the
     // controller's own events fall where its decisions did).
