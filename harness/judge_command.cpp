@@ -93,6 +93,16 @@ std::vector<std::string> differences(const CaseResult& now, const nlohmann::json
     return found;
 }
 
+// Differences between a judged case and its entry in a run's results.json
+// (`results_file` names it in the message when the case is not there).
+std::vector<std::string> differences_from_run(const CaseResult& now, const nlohmann::json& results,
+                                              const fs::path& results_file) {
+    for (const nlohmann::json& one : results.at("cases")) {
+        if (one.at("name") == now.name) return differences(now, one);
+    }
+    return {now.name + ": not in " + results_file.string()};
+}
+
 }  // namespace
 
 int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err) {
@@ -142,15 +152,10 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
                     return 2;
                 }
             }
-            const nlohmann::json* before = nullptr;
-            for (const nlohmann::json& one : before_by_dir[inputs[i].out_dir].at("cases")) {
-                if (one.at("name") == results[i].name) before = &one;
+            for (std::string& difference :
+                 differences_from_run(results[i], before_by_dir[inputs[i].out_dir], inputs[i].out_dir / "results.json")) {
+                differing.push_back(std::move(difference));
             }
-            if (before == nullptr) {
-                differing.push_back(results[i].name + ": not in " + (inputs[i].out_dir / "results.json").string());
-                continue;
-            }
-            for (std::string& difference : differences(results[i], *before)) differing.push_back(std::move(difference));
         }
     }
     if (!options.out_dir.empty()) {
@@ -218,14 +223,8 @@ int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std
                 const fs::path copy = options.out_dir / "cases" / case_dir.filename();
                 fs::copy(case_dir, copy, fs::copy_options::recursive);
                 CaseRun run = judge_trace(read_trace(copy / "trace.sqlite"));
-                const nlohmann::json* before = nullptr;
-                for (const nlohmann::json& one : shard.results.at("cases")) {
-                    if (one.at("name") == run.result.name) before = &one;
-                }
-                if (before == nullptr) {
-                    differing.push_back(run.result.name + ": not in " + (shard.dir / "results.json").string());
-                } else {
-                    for (std::string& difference : differences(run.result, *before)) differing.push_back(std::move(difference));
+                for (std::string& difference : differences_from_run(run.result, shard.results, shard.dir / "results.json")) {
+                    differing.push_back(std::move(difference));
                 }
                 results.push_back(std::move(run.result));
                 figures.push_back(std::move(run.figures));
