@@ -6,6 +6,7 @@
 #include "harness/boundary_judge.h"
 #include "harness/boundary_world.h"
 #include "harness/case_session.h"
+#include "harness/dds_security_setup.h"
 #include "harness/run_interrupt.h"
 #include "harness/trace_recorder.h"
 #include "rig/runtime/lockstep.h"
@@ -90,7 +91,8 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         const BoundaryWorld world(boundary, seed);
         CaseSession session(spec, case_dir, options.domain);
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
-        session.start_controller(spec, options.controller_executable.parent_path() / kBoundaryControllerExecutable, case_dir);
+        session.start_controller(spec, options.controller_executable.parent_path() / kBoundaryControllerExecutable, case_dir,
+                                 dds_security_environment(options.dds_security_dir, kControllerIdentity));
         TraceRecorder trace(dds, trace_file);
         trace.record_boundary_topics();
         trace.file().set_meta("case", run_name);

@@ -23,6 +23,7 @@
 #include "harness/boundary_runner.h"
 #include "harness/case_session.h"
 #include "harness/case_world.h"
+#include "harness/dds_security_setup.h"
 #include "harness/run_interrupt.h"
 #include "harness/run_progress.h"
 #include "harness/trace_recorder.h"
@@ -437,7 +438,8 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         const ControllerPlacement placement = place_controller(spec, options);
         std::string in_process_refused = placement.refused;
         if (placement.plugin) in_process_refused = session.start_in_process_controller(spec, *placement.plugin, case_dir, dds);
-        session.start_controller(spec, options.controller_executable, case_dir);
+        session.start_controller(spec, options.controller_executable, case_dir,
+                                 dds_security_environment(options.dds_security_dir, kControllerIdentity));
         TraceRecorder trace(dds, trace_file);
         trace.file().set_meta("case", run_name);
         trace.file().set_meta("case_file", spec.source_path.string());
@@ -449,6 +451,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.file().set_meta("wiring", session.wires().description);
         trace.file().set_meta("dds_domain", std::to_string(session.domain_id()));
         trace.file().set_meta("harness_guid_prefix", dds.guid_prefix());
+        if (options.dds_security_dir) trace.file().set_meta("dds_security", options.dds_security_dir->string());
         trace.file().set_meta("judging", to_json(plan_judging(spec, world)).dump());
         if (spec.wiring.external_controller) announce_attach(spec, session.wires(), run_name, case_dir, std::cout);
         trace.set_vehicle_truth_probe([&world](TimeNs t) { return world.plant.truth_at(t); });

@@ -42,6 +42,10 @@ struct RunOptions {
     // `rig run --in-process`: every case whose controller can runs in process
     // (a case's own controller.in_process wins).
     bool in_process = false;
+    // `rig run --dds-security`: the run's credentials (OUT/security,
+    // harness/dds_security_setup.h); the rig's participants hold its rig
+    // identity, the controller process is given the controller's. nullopt: none.
+    std::optional<std::filesystem::path> dds_security_dir;
     // Where run_case publishes the case's clock as it runs (a progress display);
     // nullptr: nowhere. run_cases sets it per case from its RunObserver.
     CaseClock* clock = nullptr;

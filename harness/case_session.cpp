@@ -130,7 +130,7 @@ CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case
       controller_log_(case_dir / "controller.log") {}
 
 void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
-                                   const std::filesystem::path& case_dir) {
+                                   const std::filesystem::path& case_dir, const std::vector<std::string>& environment) {
     // The controller under test, in its own process on this run's own domain
     // (none when a real board is wired up: `wiring: { controller: external }`).
     if (spec.wiring.external_controller || controller_ || in_process_) return;
@@ -153,7 +153,7 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
         argv.insert(argv.end(), {"--clock", "realtime"});
         argv.insert(argv.end(), wires_.controller_args.begin(), wires_.controller_args.end());
     }
-    controller_.emplace(argv, controller_log_);
+    controller_.emplace(argv, controller_log_, environment);
 }
 
 std::string CaseSession::start_in_process_controller(const CaseSpec& spec, const std::filesystem::path& plugin,

@@ -53,8 +53,9 @@ public:
     // controller with the wires' far ends (unless the case wires an external
     // board). Called once the harness's participant exists on the domain, so
     // discovery sees the controller's from its first moment.
+    // `environment`: set for the controller process over the rig's ("NAME=value").
     void start_controller(const CaseSpec& spec, const std::filesystem::path& controller_executable,
-                          const std::filesystem::path& case_dir);
+                          const std::filesystem::path& case_dir, const std::vector<std::string>& environment = {});
     // Software-in-the-loop: makes the controller from its plugin, to be stepped
     // by the lockstep master in this process. Returns the plugin's refusal (this
     // configuration runs as a process: start_controller then) or "" when made.

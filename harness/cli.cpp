@@ -1,7 +1,7 @@
 // `rig`: the rig's one command line (README "Running cases", `rig --help`).
 //   rig --version
-//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process] [--domain N] [--quiet | --verbose]
-//   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--out DIR]
+//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N] [--quiet | --verbose]
+//   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--dds-security] [--out DIR]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
 //   rig dds-check [--samples N] [--log-dir DIR]
@@ -31,6 +31,7 @@
 #include "harness/trace_mcap.h"
 #include "harness/case_runner.h"
 #include "harness/case_world.h"
+#include "harness/dds_security_setup.h"
 #include "harness/html_report.h"
 #include "harness/judge_command.h"
 #include "harness/output_dir.h"
@@ -43,6 +44,7 @@
 #include "rig/host/dds_check.h"
 #include "rig/host/shm_cleanup.h"
 #include "rig/host/dds_pingpong.h"
+#include "rig/runtime/dds_security.h"
 
 namespace {
 
@@ -109,6 +111,17 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     } catch (const OutputDirError& error) {
         std::cerr << "rig: " << error.what() << "; nothing was run\n";
         return 2;
+    }
+    // --dds-security: this run's credentials, before any participant exists
+    // (docs/dds-security.md); every participant of the rig's holds its identity.
+    if (options.dds_security_dir) {
+        try {
+            const DdsSecurityRun credentials = make_dds_security_run(*options.dds_security_dir);
+            rig::use_dds_security_identity(credentials.identity_dir(kRigIdentity));
+        } catch (const std::exception& error) {
+            std::cerr << "rig: --dds-security: " << error.what() << "; nothing was run\n";
+            return 2;
+        }
     }
     // What killed participants of earlier runs left in /dev/shm (rig/host/shm_cleanup.h).
     if (const rig::ShmCleanup cleaned = rig::remove_dead_participant_segments(); !cleaned.removed.empty()) {
@@ -303,6 +316,12 @@ int main(int argc, char** argv) {
                   "(a case's controller.in_process wins; others run as processes, saying why)");
     bool run_quiet = false;
     bool run_verbose = false;
+    bool run_dds_security = false;
+    auto* dds_security_flag = run->add_flag(
+        "--dds-security", run_dds_security,
+        "DDS-Security: PKI-DH authentication, access control and encryption, credentials made for this run in "
+        "OUT/security (docs/dds-security.md); controllers run as processes");
+    dds_security_flag->excludes("--in-process");
     auto* quiet_flag = run->add_flag("--quiet,-q", run_quiet,
                                      "print only the failed cases and the count: no progress, no table");
     auto* verbose_flag = run->add_flag("--verbose,-v", run_verbose,
@@ -357,6 +376,8 @@ int main(int argc, char** argv) {
     bench->add_option("--pingpong-rounds", bench_options.pingpong.rounds, "timed DDS round trips")
         ->check(CLI::Range(10, 1000000));
     bench->add_option("--out", bench_options.out_dir, "traces and bench.json");
+    bench->add_flag("--dds-security", bench_options.dds_security,
+                    "also process mode and the ping-pong with DDS-Security (credentials in OUT/security)");
     bench->add_flag("--pong", bench_pong, "internal: be the ping-pong's second process")->group("");
     bench->add_option("--domain", bench_domain, "internal: the second process's domain")->group("");
 
@@ -376,6 +397,7 @@ int main(int argc, char** argv) {
     if (mcap_command.parsed()) return mcap_command.run();
     if (run->parsed()) {
         if (seed_option->count() > 0) run_options.seed_override = seed;
+        if (run_dds_security) run_options.dds_security_dir = run_options.out_dir / "security";
         if (domain_option->count() > 0) {
             if (run_options.jobs > 1) {
                 std::cerr << "rig run: --domain " << domain << " puts every case on one domain: use it with --jobs 1\n";

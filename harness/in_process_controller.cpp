@@ -28,6 +28,13 @@ ControllerPlacement place_controller(const CaseSpec& spec, const RunOptions& opt
         placement.refused = "a real-time case: its controller runs as a process on the wall clock";
         return placement;
     }
+    // In the rig's process a controller would hold the rig's identity (one per
+    // process), which may write every device and truth topic: what the
+    // permissions exist to keep from it.
+    if (options.dds_security_dir) {
+        placement.refused = "rig run --dds-security: the controller's identity is given to a process of its own";
+        return placement;
+    }
     const std::filesystem::path plugin = controller_plugin_of(spec, options);
     if (plugin.empty()) {
         placement.refused = "controller.command names a program and no controller.plugin";

@@ -12,16 +12,35 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/dds_security_setup.h"
 #include "harness/output_dir.h"
 #include "harness/case_spec.h"
 #include "harness/results_writer.h"
+#include "rig/runtime/dds_security.h"
 
 namespace rig::harness {
 namespace {
 
 struct ModeRuns {
-    std::string mode;  // process, in_process
+    std::string mode;  // process, in_process, process_dds_security
     std::vector<CaseResult> runs;
+};
+
+// The rig's own participants hold the run's rig identity while a secured mode
+// runs, and none again after it (rig/runtime/dds_security.h).
+class RigIdentityScope {
+public:
+    explicit RigIdentityScope(const std::optional<DdsSecurityRun>& credentials) : active_(credentials.has_value()) {
+        if (active_) use_dds_security_identity(credentials->identity_dir(kRigIdentity));
+    }
+    ~RigIdentityScope() {
+        if (active_) use_dds_security_identity(std::nullopt);
+    }
+    RigIdentityScope(const RigIdentityScope&) = delete;
+    RigIdentityScope& operator=(const RigIdentityScope&) = delete;
+
+private:
+    bool active_;
 };
 
 double percentile(std::vector<double> values, double fraction) {
@@ -109,10 +128,26 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
         return 2;
     }
     const std::string load_before = load_average();
+    std::optional<DdsSecurityRun> credentials;
+    if (options.dds_security) {
+        try {
+            credentials = make_dds_security_run(options.out_dir / "security");
+        } catch (const std::exception& error) {
+            err << "rig bench: --dds-security: " << error.what() << "\n";
+            return 1;
+        }
+    }
 
     PingPongResult floor;
+    std::optional<PingPongResult> secured_floor;
     try {
         floor = run_dds_pingpong(options.pingpong);
+        if (credentials) {
+            const RigIdentityScope rig_identity(credentials);
+            PingPongOptions secured = options.pingpong;
+            secured.pong_environment = dds_security_environment(credentials->dir, kRigIdentity);
+            secured_floor = run_dds_pingpong(secured);
+        }
     } catch (const std::exception& error) {
         err << "rig bench: " << error.what() << "\n";
         return 1;
@@ -120,6 +155,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
 
     bool failed = false;
     std::vector<ModeRuns> modes = {{"process", {}}, {"in_process", {}}};
+    if (credentials) modes.push_back({"process_dds_security", {}});
     std::map<std::string, std::set<std::string>> digests;  // case -> digests seen in every run of both modes
     for (ModeRuns& mode : modes) {
         for (const CaseSpec& spec : specs) {
@@ -128,10 +164,14 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 run_options.jobs = 1;
                 run_options.in_process = mode.mode == "in_process";
                 run_options.out_dir = options.out_dir / mode.mode / std::to_string(r);
+                const bool secured = mode.mode == "process_dds_security";
+                if (secured) run_options.dds_security_dir = credentials->dir;
+                const RigIdentityScope rig_identity(secured ? credentials : std::nullopt);
                 const std::vector<CaseInstance> instances = expand_runs({spec}, run_options);
                 const CaseRun run = run_case(spec, instances.front().seed, instances.front().name, run_options);
                 const CaseResult& result = run.result;
-                if (!result.error.empty() || result.controller_mode != mode.mode) {
+                const std::string expected_mode = secured ? "process" : mode.mode;
+                if (!result.error.empty() || result.controller_mode != expected_mode) {
                     err << "rig bench: " << result.name << " (" << mode.mode << ", run " << r + 1 << "): "
                         << (result.error.empty() ? "ran as " + result.controller_mode : result.error) << "\n";
                     failed = true;
@@ -162,7 +202,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
         << load_average() << " after\n";
     out << "  simulated per case " << fixed(sim_per_case, 1) << " s; " << fixed(process.rounds_per_sim_s, 1)
         << " rounds per simulated second; trace digests "
-        << (digests_equal ? "identical in every run of both modes" : "DIFFER (see above)") << "\n\n";
+        << (digests_equal ? (credentials ? "identical in every run of every mode" : "identical in every run of both modes") : "DIFFER (see above)") << "\n\n";
     out << "                               us/round  rounds/s  x real time  start-up p50/p99 s  trace KB/sim-min  "
            "vs floor\n";
     out << "  DDS ping-pong, 2 processes   " << std::setw(8) << fixed(floor.p50_us, 1) << "  " << std::setw(8)
@@ -178,6 +218,19 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     };
     row("process mode                 ", process);
     row("in process (SIL)             ", in_process);
+    std::optional<ModeFigures> secured;
+    if (credentials) {
+        secured = figures_of(modes[2].runs);
+        out << "  DDS ping-pong, DDS-Security  " << std::setw(8) << fixed(secured_floor->p50_us, 1) << "  "
+            << std::setw(8) << fixed(1e6 / std::max(secured_floor->p50_us, 1e-9), 0) << "  " << std::setw(11) << "-"
+            << "  " << std::setw(18) << (fixed(secured_floor->matched_after_s, 3) + " (match)") << "  "
+            << std::setw(16) << "-" << "  " << std::setw(8) << fixed(secured_floor->p50_us / std::max(floor_us, 1e-9), 2)
+            << "   (p99 " << fixed(secured_floor->p99_us, 1) << " us, " << secured_floor->rounds << " round trips)\n";
+        row("process mode, DDS-Security   ", *secured);
+        out << "  DDS-Security costs " << fixed(secured->us_per_round - process.us_per_round, 1)
+            << " us per round in process mode (" << fixed(secured_floor->p50_us - floor_us, 1)
+            << " us per ping-pong round trip)\n";
+    }
     out << "\n  us/round: stepping wall time / rounds (a round: the rig's nodes, a tick to the controller, its "
            "answer);\n  x real time: simulated / wall per case, start-up included; vs floor: us/round / ping-pong "
            "p50.\n";
@@ -200,6 +253,21 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                      {"startup_p99_s", f.startup_p99_s},
                      {"trace_bytes_per_sim_minute", f.trace_bytes_per_sim_minute},
                      {"ratio_to_floor", f.us_per_round / std::max(floor_us, 1e-9)}};
+    }
+    if (secured) {
+        json["pingpong_dds_security"] = {{"rounds", secured_floor->rounds},
+                                         {"p50_us", secured_floor->p50_us},
+                                         {"p99_us", secured_floor->p99_us},
+                                         {"mean_us", secured_floor->mean_us},
+                                         {"matched_after_s", secured_floor->matched_after_s}};
+        json["process_dds_security"] = {{"us_per_round", secured->us_per_round},
+                                        {"rounds_per_s", secured->rounds_per_s},
+                                        {"rounds", secured->rounds},
+                                        {"x_real_time", secured->x_real_time},
+                                        {"startup_p50_s", secured->startup_p50_s},
+                                        {"startup_p99_s", secured->startup_p99_s},
+                                        {"ratio_to_floor", secured->us_per_round / std::max(floor_us, 1e-9)},
+                                        {"extra_us_per_round", secured->us_per_round - process.us_per_round}};
     }
     std::filesystem::create_directories(options.out_dir);
     std::ofstream(options.out_dir / "bench.json") << json.dump(2) << "\n";

@@ -26,6 +26,9 @@ struct SpeedBenchOptions {
     PingPongOptions pingpong;
     std::filesystem::path out_dir = "rig-bench";  // traces, bench.json
     RunOptions run;                  // controller executable and plugin
+    // Also process mode and the ping-pong with DDS-Security (credentials made in
+    // out_dir/security, docs/dds-security.md): what it costs per round.
+    bool dds_security = false;
 };
 
 // Prints the table; writes out_dir/bench.json. Returns 0, 1 when a run failed

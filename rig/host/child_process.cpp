@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
 
 #include "rig/runtime/clock.h"
 
@@ -26,7 +27,8 @@ bool mark_close_on_exec(int max_fd) {
 
 }  // namespace
 
-ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path) {
+ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path,
+                           const std::vector<std::string>& environment) {
     if (argv.empty()) throw std::runtime_error("empty command for a node process");
     for (const auto& arg : argv) command_line_ += (command_line_.empty() ? "" : " ") + arg;
 
@@ -35,6 +37,18 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
     std::vector<char*> raw_argv;
     for (const auto& arg : argv) raw_argv.push_back(const_cast<char*>(arg.c_str()));
     raw_argv.push_back(nullptr);
+    // The child's environment: ours, with `environment` set over it.
+    std::vector<std::string> child_environment(environment);
+    for (char** variable = environ; *variable != nullptr; ++variable) {
+        const std::string_view entry(*variable);
+        const std::string_view name = entry.substr(0, entry.find('='));
+        bool overridden = false;
+        for (const std::string& set : environment) overridden |= set.size() > name.size() && set.compare(0, name.size(), name) == 0 && set[name.size()] == '=';
+        if (!overridden) child_environment.emplace_back(entry);
+    }
+    std::vector<char*> raw_environment;
+    for (const auto& entry : child_environment) raw_environment.push_back(const_cast<char*>(entry.c_str()));
+    raw_environment.push_back(nullptr);
     const std::string log = log_path.string();
     const pid_t parent = ::getpid();
     // For kernels without close_range (before 5.11): the fds to mark one by one.
@@ -73,7 +87,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
             // Nothing but stdin/out/err crosses exec: not the rig's DDS sockets
             // (a controller holding them would keep the rig's ports bound after
             // the rig is gone), not its trace files, not its ptys' masters.
-            ::execvp(raw_argv[0], raw_argv.data());
+            ::execvpe(raw_argv[0], raw_argv.data(), raw_environment.data());
             err = errno;
         }
         [[maybe_unused]] const auto written = ::write(report[1], &err, sizeof err);

@@ -14,9 +14,12 @@ namespace rig {
 
 class ChildProcess {
 public:
-    // Starts argv[0] (searched in PATH if it has no '/'), stdout+stderr to log_path.
-    // Throws std::runtime_error naming the command when it cannot be started.
-    ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path);
+    // Starts argv[0] (searched in PATH if it has no '/'), stdout+stderr to log_path,
+    // with this process's environment and `environment` ("NAME=value" each, set
+    // over it: the controller's DDS-Security identity). Throws std::runtime_error
+    // naming the command when it cannot be started.
+    ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path,
+                 const std::vector<std::string>& environment = {});
     ~ChildProcess();  // terminates if still running
     ChildProcess(const ChildProcess&) = delete;
     ChildProcess& operator=(const ChildProcess&) = delete;

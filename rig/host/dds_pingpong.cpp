@@ -44,7 +44,7 @@ PingPongResult run_dds_pingpong(const PingPongOptions& options) {
     const std::uint32_t total = options.warmup_rounds + options.rounds;
     ChildProcess echo({options.pong_executable.string(), "bench", "--pong", "--domain", std::to_string(lease.domain_id()),
                        "--pingpong-rounds", std::to_string(total)},
-                      options.log_dir / "bench-pong.log");
+                      options.log_dir / "bench-pong.log", options.pong_environment);
     auto fail = [&](const std::string& what) -> PingPongResult {
         const std::string ended = echo.stop(std::chrono::milliseconds(500));
         throw std::runtime_error("DDS ping-pong: " + what + " (second process: " + ended + ")");

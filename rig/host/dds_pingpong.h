@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace rig {
 
@@ -17,6 +18,9 @@ struct PingPongOptions {
     std::uint32_t topics_in_tick = 16;   // entries in the tick's published_counts, as a case's tick carries
     std::filesystem::path pong_executable;  // the `rig` binary; started as `rig bench --pong`
     std::filesystem::path log_dir;
+    // Set for the second process over this one's environment ("NAME=value"):
+    // its DDS-Security identity when the floor is measured secured.
+    std::vector<std::string> pong_environment;
 };
 
 struct PingPongResult {

@@ -8,6 +8,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "rig/runtime/dds_security.h"
 #include "rig/runtime/participant_factory.h"
 
 namespace rig {
@@ -198,6 +199,7 @@ DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_n
     if (watch_discovery) discovery_ = std::make_unique<DiscoveryWatch>();
     participant_ = create_loopback_participant(domain_id, participant_name, discovery_.get());
     guid_prefix_ = prefix_of(participant_->guid().guidPrefix);
+    secured_ = has_dds_security(participant_->get_qos().properties());
     publisher_ = participant_->create_publisher(participant_->get_default_publisher_qos());
     subscriber_ = participant_->create_subscriber(participant_->get_default_subscriber_qos());
     if (publisher_ == nullptr || subscriber_ == nullptr) {
@@ -303,8 +305,12 @@ std::vector<DiscoveredEndpoint> DdsContext::take_discoveries() {
 
 bool DdsContext::is_rig_participant(const std::string& guid_prefix) const {
     // Fast DDS prefixes: 2 bytes vendor, 2 bytes host, 4 bytes process, 4 bytes participant.
-    constexpr std::size_t kProcessHexDigits = 16;
-    if (guid_prefix.compare(0, kProcessHexDigits, guid_prefix_, 0, kProcessHexDigits) != 0) return false;
+    // With DDS-Security the prefix is the PKI-DH "adjusted" one instead: its
+    // first 6 bytes (47 bits) come from a hash of the certificate's subject, the
+    // rest from a hash of the plain prefix, so what a secured participant's
+    // prefix says is whose identity it holds: the rig's is the one of ours.
+    const std::size_t owner_hex_digits = secured_ ? 12 : 16;
+    if (guid_prefix.compare(0, owner_hex_digits, guid_prefix_, 0, owner_hex_digits) != 0) return false;
     std::lock_guard lock(guests_mutex_);
     return std::find(guest_prefixes_.begin(), guest_prefixes_.end(), guid_prefix) == guest_prefixes_.end();
 }

@@ -183,7 +183,8 @@ public:
     // This participant's GUID prefix (hex), as Reader::take_all_with_writer reports writers.
     const std::string& guid_prefix() const { return guid_prefix_; }
     // Whether a participant is the rig's own: its GUID prefix is of this process
-    // (the first 8 bytes, vendor, host and process, are ours), whichever case or
+    // (the first 8 bytes, vendor, host and process, are ours; with DDS-Security,
+    // the first 6, which say whose certificate it holds), whichever case or
     // domain it serves, and it is not a guest. Samples and endpoints of the
     // rig's own participants never count as a controller's.
     bool is_rig_participant(const std::string& guid_prefix) const;
@@ -249,6 +250,7 @@ private:
     std::uint32_t domain_id_;
     std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
     std::string guid_prefix_;
+    bool secured_ = false;  // created with a DDS-Security identity (rig/runtime/dds_security.h)
     mutable std::mutex guests_mutex_;
     std::vector<std::string> guest_prefixes_;
     dds::DomainParticipant* participant_ = nullptr;

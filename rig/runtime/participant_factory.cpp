@@ -10,6 +10,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
+#include "rig/runtime/dds_security.h"
+
 namespace rig {
 
 extern const char* const kLoopbackProfileXml;  // generated from loopback_profile.xml
@@ -71,6 +73,11 @@ dds::DomainParticipant* create_loopback_participant(std::uint32_t domain_id, con
         throw std::runtime_error(std::string("cannot read DDS participant profile ") + kLoopbackProfileName);
     }
     qos.name(participant_name);
+    // DDS-Security, when this process has an identity (rig/runtime/dds_security.h):
+    // the plugins go on top of the profile; its transports and discovery stay as they are.
+    if (const std::filesystem::path identity = dds_security_identity(); !identity.empty()) {
+        add_dds_security_properties(identity, qos.properties());
+    }
     std::lock_guard lock(ids_mutex);
     const int participant_id = lowest_free_id();
     qos.wire_protocol().participant_id = participant_id;
@@ -78,8 +85,12 @@ dds::DomainParticipant* create_loopback_participant(std::uint32_t domain_id, con
                                                     dds::StatusMask::none());
     if (participant != nullptr) ids_in_use[participant] = participant_id;
     if (participant == nullptr) {
+        const std::filesystem::path identity = dds_security_identity();
         throw std::runtime_error("cannot create DDS participant '" + participant_name + "' on domain " +
-                                 std::to_string(domain_id) + " from profile " + kLoopbackProfileName);
+                                 std::to_string(domain_id) + " from profile " + kLoopbackProfileName +
+                                 (identity.empty() ? std::string()
+                                                   : " with the DDS-Security identity " + identity.string() +
+                                                         " (Fast DDS's log above says what it refused)"));
     }
     return participant;
 }
