@@ -483,6 +483,10 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
             trace.file().set_meta(kGnssWireFaultsMeta,
                                   gnss_wire_fault_json(spec.gnss.wire_faults, nodes.gnss.wire_fault_counts()).dump());
         }
+        if (options.dds_security_dir) {
+            // Who tried to join and was refused (not in the digest: it depends on who was around).
+            trace.file().set_meta("dds_security_refused", nlohmann::json(dds.refused_participants()).dump());
+        }
         trace.file().set_meta("run", run_facts_json(facts, wall.elapsed_s()).dump());
         trace.file().finish(outcome);
     } catch (const std::exception& error) {

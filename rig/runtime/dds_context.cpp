@@ -182,6 +182,15 @@ public:
         add(prefix_of(info.info.guid().guidPrefix), info.info.topicName().to_string(), info.info.typeName().to_string(),
             true, info.status == Status::REMOVED_WRITER);
     }
+#if HAVE_SECURITY  // Fast DDS built without its security plugins has no such callback
+    void onParticipantAuthentication(dds::DomainParticipant*,
+                                     eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+        if (info.status != eprosima::fastrtps::rtps::ParticipantAuthenticationInfo::UNAUTHORIZED_PARTICIPANT) return;
+        const std::string prefix = prefix_of(info.guid.guidPrefix);
+        std::lock_guard lock(mutex);
+        if (std::find(refused.begin(), refused.end(), prefix) == refused.end()) refused.push_back(prefix);
+    }
+#endif
     void add(std::string prefix, std::string topic, std::string type, bool writer, bool removed) {
         std::lock_guard lock(mutex);
         const auto name = names.find(prefix);
@@ -192,6 +201,7 @@ public:
     mutable std::mutex mutex;
     std::map<std::string, std::string> names;  // GUID prefix -> participant name
     std::vector<DiscoveredEndpoint> pending;
+    std::vector<std::string> refused;  // GUID prefixes whose authentication failed
 };
 
 DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery)
@@ -318,6 +328,12 @@ bool DdsContext::is_rig_participant(const std::string& guid_prefix) const {
 void DdsContext::add_guest_participant(const std::string& guid_prefix) {
     std::lock_guard lock(guests_mutex_);
     guest_prefixes_.push_back(guid_prefix);
+}
+
+std::vector<std::string> DdsContext::refused_participants() const {
+    if (!discovery_) return {};
+    std::lock_guard lock(discovery_->mutex);
+    return discovery_->refused;
 }
 
 std::string DdsContext::participant_name(const std::string& guid_prefix) const {

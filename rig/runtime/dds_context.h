@@ -195,6 +195,10 @@ public:
     // Endpoints of participants of other processes discovered or removed since the
     // last call, in the order discovery reported them (empty unless watch_discovery).
     std::vector<DiscoveredEndpoint> take_discoveries();
+    // DDS-Security: the GUID prefixes of the participants whose authentication
+    // this one refused (no identity, or one the run's CA did not sign), each
+    // once, in order (empty unless watch_discovery).
+    std::vector<std::string> refused_participants() const;
     // The name a participant announced, by GUID prefix ("?" when unknown).
     std::string participant_name(const std::string& guid_prefix) const;
     dds::DomainParticipant& participant() { return *participant_; }
