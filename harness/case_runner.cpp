@@ -382,6 +382,15 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
 }  // namespace
 
 void validate_for_run(const CaseSpec& spec, const RunOptions& options) {
+    // A wired board's valve commands come over its wire, and the rig's own
+    // bridge puts them on the actuator topics, which the rig's identity may
+    // not write (docs/dds-security.md): DDS-Security protects none of that.
+    if (options.dds_security_dir && spec.wiring.board_io != BoardIoWireKind::dds) {
+        throw std::runtime_error(spec.source_path.string() + ": wiring.board_io " +
+                                 std::string(to_string(spec.wiring.board_io)) +
+                                 ": the controller's commands come over the wire and the rig writes them on the "
+                                 "actuator topics itself; run it without --dds-security");
+    }
     // Seed 001's reference boundary controller (a program; its configuration
     // library is the harness's too).
     if (spec.system == CaseSystem::boundary && spec.controller.command.empty()) {

@@ -220,7 +220,7 @@ TEST(DdsSecurity, PermissionsFollowTheTopicTable) {
     EXPECT_THROW(rig::harness::topic_grant("observer"), std::runtime_error);
 }
 
-TEST(DdsSecurity, InProcessControllersAreRefusedWithTheReason) {
+TEST(DdsSecurity, InProcessAndWiredCasesAreRefusedWithTheReason) {
     rig::harness::CaseSpec spec = rig::harness::load_case_file(kCase);
     spec.controller.in_process = true;
     rig::harness::RunOptions options;
@@ -229,6 +229,13 @@ TEST(DdsSecurity, InProcessControllersAreRefusedWithTheReason) {
     const rig::harness::ControllerPlacement placement = rig::harness::place_controller(spec, options);
     EXPECT_FALSE(placement.plugin.has_value());
     EXPECT_NE(placement.refused.find("--dds-security"), std::string::npos) << placement.refused;
+    // A wired board's commands come over its wire and the rig itself writes them on the actuator topics.
+    const auto wired = rig::testing::run_shell(kRig.string() + " run " RIG_SOURCE_DIR
+                                               "/cases/bench-wired/continuation-6kmh-wired-rtu.yaml --dds-security --out " +
+                                               (fresh_dir("dds_security_wired") / "out").string() + " 2>&1");
+    EXPECT_EQ(wired.exit_code, 2) << wired.output;
+    EXPECT_NE(wired.output.find("continuation-6kmh-wired-rtu.yaml: wiring.board_io modbus_rtu"), std::string::npos)
+        << wired.output;
     // Both on the command line: a usage error naming them.
     const auto both = rig::testing::run_shell(kRig.string() + " run " + kCase + " --dds-security --in-process --out " +
                                               (fresh_dir("dds_security_usage") / "out").string() + " 2>&1");
