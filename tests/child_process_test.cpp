@@ -111,6 +111,21 @@ TEST(ChildProcess, TheLogFileGetsStdoutAndStderr) {
     EXPECT_EQ(text, "out\nerr\n");
 }
 
+TEST(ChildProcess, GetsTheRigsEnvironmentWithItsOwnVariablesSetOverIt) {
+    // How the controller gets its DDS-Security identity (RIG_DDS_SECURITY_DIR).
+    ::setenv("RIG_CHILD_TEST_KEPT", "from the rig", 1);
+    ::setenv("RIG_CHILD_TEST_SET", "the rig's value", 1);
+    const std::string log = temp_path("environment.log");
+    rig::ChildProcess printer({"/bin/sh", "-c", "echo \"$RIG_CHILD_TEST_KEPT|$RIG_CHILD_TEST_SET|$RIG_CHILD_TEST_NEW\""}, log,
+                              {"RIG_CHILD_TEST_SET=the child's", "RIG_CHILD_TEST_NEW=new=with equals"});
+    for (int i = 0; i < 2000 && !printer.exit_description(); ++i) std::this_thread::sleep_for(5ms);
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text, "from the rig|the child's|new=with equals\n");
+    ::unsetenv("RIG_CHILD_TEST_KEPT");
+    ::unsetenv("RIG_CHILD_TEST_SET");
+}
+
 TEST(ChildProcess, InheritsNoDescriptorButItsStandardOnes) {
     // An fd of the rig's without close-on-exec (as Fast DDS's sockets are):
     // the controller must not get it.

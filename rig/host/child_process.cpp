@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -42,8 +43,9 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
     for (char** variable = environ; *variable != nullptr; ++variable) {
         const std::string_view entry(*variable);
         const std::string_view name = entry.substr(0, entry.find('='));
-        bool overridden = false;
-        for (const std::string& set : environment) overridden |= set.size() > name.size() && set.compare(0, name.size(), name) == 0 && set[name.size()] == '=';
+        const bool overridden = std::any_of(environment.begin(), environment.end(), [&](const std::string& set) {
+            return set.size() > name.size() && set.compare(0, name.size(), name) == 0 && set[name.size()] == '=';
+        });
         if (!overridden) child_environment.emplace_back(entry);
     }
     std::vector<char*> raw_environment;
