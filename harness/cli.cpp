@@ -391,6 +391,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& error) {
         return usage_error(app, error);
     }
+    // Only --dds-security secures the rig's participants: RIG_DDS_SECURITY_DIR
+    // is the controller's contract, read here by the bench's second process alone.
+    if (!(bench->parsed() && bench_pong)) rig::use_dds_security_identity(std::filesystem::path());
     if (pty_bench.parsed()) return pty_bench.run();
     if (hid_bench.parsed()) return hid_bench.run();
     if (emulate_bench.parsed()) return emulate_bench.run();

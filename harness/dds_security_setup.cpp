@@ -121,7 +121,9 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
 
 std::vector<std::string> dds_security_environment(const std::optional<std::filesystem::path>& run_dir,
                                                   const std::string& identity) {
-    if (!run_dir) return {};
+    // Without credentials, the variable is set empty: one in the rig's own
+    // environment must not give the controller an identity the rig does not share.
+    if (!run_dir) return {std::string(kDdsSecurityDirEnv) + "="};
     return {std::string(kDdsSecurityDirEnv) + "=" + std::filesystem::absolute(*run_dir / identity).string()};
 }
 

@@ -30,7 +30,8 @@ struct DdsSecurityRun {
 DdsSecurityRun make_dds_security_run(const std::filesystem::path& dir, const std::string& openssl = "openssl");
 
 // What a process started with this identity is given: RIG_DDS_SECURITY_DIR set
-// to its directory (rig/runtime/dds_security.h); nothing without a run's credentials.
+// to its directory (rig/runtime/dds_security.h); set empty (no identity)
+// without a run's credentials.
 std::vector<std::string> dds_security_environment(const std::optional<std::filesystem::path>& run_dir,
                                                   const std::string& identity);
 

@@ -43,9 +43,10 @@ struct RunResult {
     nlohmann::json the_case;  // its only case in results.json
 };
 
-RunResult rig_run(const std::string& args, const std::filesystem::path& out) {
+// `environment`: assignments put before the command ("NAME=value ").
+RunResult rig_run(const std::string& args, const std::filesystem::path& out, const std::string& environment = "") {
     RunResult run;
-    run.output = read_all_command(kRig.string() + " run " + kCase + " --seed 1 " + args + " --out " + out.string() +
+    run.output = read_all_command(environment + kRig.string() + " run " + kCase + " --seed 1 " + args + " --out " + out.string() +
                                   " 2>&1; echo \"exit=$?\"");
     std::smatch exit_code;
     if (std::regex_search(run.output, exit_code, std::regex("exit=(\\d+)\\s*$"))) run.exit_code = std::stoi(exit_code[1]);
@@ -96,7 +97,9 @@ TEST(DdsSecurity, IntrudersReachAPlainRunButNotASecuredOneWhoseTraceIsThePlainOn
     // controller's very subject name, permissions to command every actuator.
     const rig::harness::DdsSecurityRun foreign = rig::harness::make_dds_security_run(dir / "foreign-ca");
 
-    const RunResult plain = rig_run("", dir / "plain");
+    // The variable is the controller's contract: a plain run neither takes it
+    // for the rig nor passes it on to the controller (this directory does not exist).
+    const RunResult plain = rig_run("", dir / "plain", "RIG_DDS_SECURITY_DIR=" + (dir / "no-such-identity").string() + " ");
     ASSERT_EQ(plain.exit_code, 0) << plain.output;
     const std::string digest = plain.the_case.value("trace_sha256", "");
     ASSERT_FALSE(digest.empty()) << plain.output;
