@@ -403,6 +403,12 @@ std::vector<CaseInstance> expand_runs(const std::vector<CaseSpec>& specs, const 
     std::vector<CaseInstance> runs;
     for (std::size_t i = 0; i < specs.size(); ++i) {
         const CaseSpec& spec = specs[i];
+        if (!options.seed_sweep.empty()) {
+            for (std::uint64_t seed : options.seed_sweep) {
+                runs.push_back(CaseInstance{i, seed, spec.name + "-seed" + std::to_string(seed)});
+            }
+            continue;
+        }
         if (spec.seeds.empty()) {
             runs.push_back(CaseInstance{i, options.seed_override.value_or(spec.seed), spec.name});
             continue;
@@ -529,6 +535,7 @@ std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOpti
             runs[i] = run_case(spec, instance.seed, instance.name, case_options);
         }
         observer.case_finished(i, runs[i].result);
+        if (!options.keep_figures) runs[i].figures = CaseFigures{};
     };
     // Lockstep cases share the machine; a real-time case runs alone, after them,
     // so that other cases' load does not become its scheduling jitter.
