@@ -12,7 +12,7 @@
 // OUT report 0x01 "command" (rig -> board)
 //   off size  field
 //    0   1    report id 0x01
-//    1   1    protocol version (kProtocolVersion)
+//    1   1    protocol version: 1, or 2 when byte 22 asks for capture
 //    2   2    command sequence: +1 per command report, wraps
 //    4   4    wheel-encoder target: the CUMULATIVE pulse count the encoder output
 //             shall have reached at the end of the spread interval (wraps at 2^32)
@@ -23,11 +23,12 @@
 //   20   1    digital outputs: bit0 breakpoint button pressed, bit1 spray switch
 //             on; bits 2-7 reserved
 //   21   1    command flags: bit0 re-base counters; bits 1-7 reserved
-//   22  42    reserved
+//   22   1    version 2: PWM capture inputs (below); version 1: reserved
+//   23  41    reserved
 //
 // IN report 0x02 "status" (board -> rig), sent periodically and on change
 //    0   1    report id 0x02
-//    1   1    protocol version
+//    1   1    protocol version of the last command applied (1 or 2; same layout)
 //    2   2    status sequence: +1 per status report, wraps (gaps = lost reports)
 //    4   2    sequence of the last command report the board applied
 //    6   1    relay inputs: bit0 ball valve forward, bit1 ball valve reverse,
