@@ -178,10 +178,11 @@ BoundaryCaseSpec read_boundary_case(const YamlSection& root) {
     if (spec.edges.size() > 16) judge.fail("edges", "at most 16 edges");
     spec.judge_flow_per_duty = judge.optional<bool>("flow_per_duty", spec.judge_flow_per_duty);
     spec.flow_settle_s = judge.optional_in_range<double>("flow_settle_s", spec.flow_settle_s, Bounds::closed(0, 60));
+    spec.judge_centre_rule = judge.optional<bool>("centre_rule", spec.judge_centre_rule);
     spec.end_after_route_s =
         judge.optional_in_range<double>("end_after_route_s", spec.end_after_route_s, Bounds::closed(0, 600));
-    if (spec.edges.empty() && !spec.judge_flow_per_duty) {
-        judge.fail("judge nothing? give `edges` or `flow_per_duty: true`");
+    if (spec.edges.empty() && !spec.judge_flow_per_duty && !spec.judge_centre_rule) {
+        judge.fail("judge nothing? give `edges`, `flow_per_duty: true` or `centre_rule: true`");
     }
     return spec;
 }

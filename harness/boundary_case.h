@@ -12,7 +12,8 @@
 //   spray:    fan and deposition step; flow_table: per nozzle [ { duty_pct, flow_ml_min } ] (Table 3 by default)
 //   valves:   PWM valves; ad300: the receiver; laser: the L4
 //   judge:    ground grid, wet threshold, the edges to measure and the metric
-//             each gives, flow per duty (Table 3)
+//             each gives, flow per duty (Table 3), centre_rule (Sec. 4.2's
+//             boom-centre rule, Table 8 "along, boom centre outside")
 // Every parameter is declared once, in the emulator's own parameter struct
 // (emulators/ad300_receiver.h, l4_laser_sensor.h, pwm_nozzle_valves.h,
 // boundary_spray_plant.h, field2d/*), with unit, default and provenance; the
@@ -67,6 +68,8 @@ struct BoundaryCaseSpec {
     bool judge_flow_per_duty = false;      // Table 3: flow per duty per nozzle from the delivered volumes
     // Flow per duty skips this long after each duty change (the first PWM periods).
     double flow_settle_s = 0.5;            // [0, 60]
+    // Sec. 4.2's boom-centre rule from truth (centre_out_* metrics, harness/boundary_metrics.h).
+    bool judge_centre_rule = false;
     double end_after_route_s = 1.0;        // the run ends this long after the route does, [0, 600]
 
     field2d::NozzleFlowTable flow_table_or_paper() const;

@@ -62,6 +62,8 @@ BoundaryJudgingPlan plan_boundary_judging(const BoundaryCaseSpec& spec) {
     plan.pwm_period_s = 1.0 / spec.valves.frequency_hz;
     const field2d::NozzleFlowTable table = spec.flow_table_or_paper();
     for (int n = 0; n < table.nozzle_count(); ++n) plan.flow_table.push_back(table.points(n));
+    plan.centre_rule = spec.judge_centre_rule;
+    plan.area = area.vertices();
     return plan;
 }
 
@@ -83,6 +85,8 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
         for (const field2d::FlowPoint& p : nozzle) points.push_back({p.duty_pct, p.flow_ml_min});
         table.push_back(std::move(points));
     }
+    nlohmann::json area = nlohmann::json::array();
+    for (const field2d::Vec2& v : plan.area) area.push_back({v.east_m, v.north_m});
     return {{"ground",
              {{"east_min_m", plan.ground.east_min_m},
               {"east_max_m", plan.ground.east_max_m},
@@ -96,7 +100,9 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
             {"flow_per_duty", plan.flow_per_duty},
             {"flow_settle_s", plan.flow_settle_s},
             {"pwm_period_s", plan.pwm_period_s},
-            {"flow_table_ml_min", std::move(table)}};
+            {"flow_table_ml_min", std::move(table)},
+            {"centre_rule", plan.centre_rule},
+            {"area", std::move(area)}};
 }
 
 BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) {
@@ -132,6 +138,14 @@ BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) 
             std::vector<field2d::FlowPoint> points;
             for (const nlohmann::json& p : nozzle) points.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
             plan.flow_table.push_back(std::move(points));
+        }
+        // Plans written before the centre rule was judged have neither key.
+        if (json.contains("centre_rule")) plan.centre_rule = json.at("centre_rule").get<bool>();
+        if (json.contains("area")) {
+            for (const nlohmann::json& v : json.at("area")) plan.area.push_back({v.at(0).get<double>(), v.at(1).get<double>()});
+        }
+        if (plan.centre_rule && plan.area.size() < 3) {
+            throw std::runtime_error("boundary judging plan: centre_rule needs `area` with at least 3 corners");
         }
         return plan;
     } catch (const nlohmann::json::exception& error) {
@@ -254,6 +268,28 @@ MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgi
             for (const DoseRaster& layer : layers) per_nozzle.push_back(wet_edge_profile(layer, e.edge, e.probe));
             for (const auto& [name, value] : per_nozzle_excess_metrics(e.metric, per_nozzle)) metrics.values[name] = value;
         }
+    }
+    if (plan.centre_rule) {
+        // The boom centre is the nozzles' midpoint (they sit symmetric about it).
+        std::vector<CentreRuleSample> samples;
+        std::vector<double> previous;
+        for (const NozzleStepTruth& step : steps) {
+            if (step.position.empty()) continue;
+            CentreRuleSample sample;
+            sample.t_s = ns_to_seconds(step.t_ns);
+            for (const field2d::Vec2& p : step.position) {
+                sample.centre.east_m += p.east_m / static_cast<double>(step.position.size());
+                sample.centre.north_m += p.north_m / static_cast<double>(step.position.size());
+            }
+            previous.resize(step.delivered_l.size(), 0.0);
+            for (std::size_t n = 0; n < step.delivered_l.size(); ++n) {
+                sample.volume_l += std::max(0.0, step.delivered_l[n] - previous[n]);
+                previous[n] = step.delivered_l[n];
+            }
+            samples.push_back(sample);
+        }
+        for (const auto& [name, value] : centre_rule_metrics(samples, field2d::Polygon(plan.area, "target area")))
+            metrics.values[name] = value;
     }
     if (plan.flow_per_duty) {
         const field2d::NozzleFlowTable table(plan.flow_table);

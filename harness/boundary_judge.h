@@ -37,6 +37,8 @@ struct BoundaryJudgingPlan {
     double flow_settle_s = 0.5;
     double pwm_period_s = 1.0 / 9.0;
     std::vector<std::vector<field2d::FlowPoint>> flow_table;  // what the plant was given (Table 3)
+    bool centre_rule = false;
+    std::vector<field2d::Vec2> area;       // local frame, counter-clockwise; the centre rule's area
 };
 
 // From the case: the area's edges in the local frame (its corners through the

@@ -254,4 +254,53 @@ std::map<std::string, double> eq13_fit_metrics(const std::vector<FlowCheckRow>& 
     return m;
 }
 
+std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples,
+                                                  const field2d::Polygon& area) {
+    double crossings = 0.0;
+    double out_samples = 0.0;
+    double spray_l = 0.0;
+    double longest_s = 0.0;
+    double longest_m = 0.0;
+    bool was_out = false;
+    double left_s = 0.0;        // when the running spell outside began
+    double travel_m = 0.0;      // the centre's travel since then
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        const CentreRuleSample& s = samples[i];
+        const auto where = [&] { return "centre rule: sample " + std::to_string(i) + " (t " + std::to_string(s.t_s) + " s)"; };
+        if (!std::isfinite(s.t_s) || !std::isfinite(s.centre.east_m) || !std::isfinite(s.centre.north_m) ||
+            !std::isfinite(s.volume_l)) {
+            throw std::invalid_argument(where() + ": non-finite value");
+        }
+        if (s.volume_l < 0.0) throw std::invalid_argument(where() + ": negative volume " + std::to_string(s.volume_l));
+        if (i > 0 && s.t_s < samples[i - 1].t_s) throw std::invalid_argument(where() + ": time goes back");
+        const bool out = !area.contains(s.centre);
+        if (!out) {
+            was_out = false;
+            continue;
+        }
+        ++out_samples;
+        if (!was_out) {
+            ++crossings;
+            left_s = s.t_s;
+            travel_m = 0.0;
+        } else {
+            travel_m += std::hypot(s.centre.east_m - samples[i - 1].centre.east_m,
+                                   s.centre.north_m - samples[i - 1].centre.north_m);
+        }
+        was_out = true;
+        if (s.volume_l > 0.0) {
+            spray_l += s.volume_l;
+            if (s.t_s - left_s >= longest_s) {
+                longest_s = s.t_s - left_s;
+                longest_m = travel_m;
+            }
+        }
+    }
+    return {{"centre_out_crossings", crossings},
+            {"centre_out_samples", out_samples},
+            {"centre_out_spray_ml", spray_l * 1000.0},
+            {"centre_out_close_s", longest_s},
+            {"centre_out_close_m", longest_m}};
+}
+
 }  // namespace rig::harness

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "emulators/field2d/nozzle_flow_table.h"
+#include "emulators/field2d/polygon.h"
 
 namespace rig::harness {
 
@@ -87,6 +88,32 @@ std::map<std::string, double> excess_metrics(const std::string& prefix, const Ed
 // nozzle's own layer's profile (index = nozzle number).
 std::map<std::string, double> per_nozzle_excess_metrics(const std::string& prefix,
                                                         const std::vector<EdgeProfile>& per_nozzle);
+
+// ---------------------------------------------------------------- the boom-centre rule (Sec. 4.2, Table 8 "along")
+
+// Sec. 4.2's second rule: while the boom centre is outside the target area,
+// every nozzle is off (spraying environment 2, running along the headland).
+// Judged from truth: the boom centre (the nozzles' midpoint, where the L4 sits)
+// against the area, and the volume the plant delivered. A controller that
+// obeys the rule stops all delivery within its loop delay (next RMC epoch, RMC
+// latency, PWM latch, valve stroke) after the centre leaves the area and
+// delivers nothing while it stays out.
+struct CentreRuleSample {
+    double t_s = 0.0;              // in time order
+    field2d::Vec2 centre;          // truth, local frame
+    double volume_l = 0.0;         // all nozzles, delivered since the previous sample (>= 0)
+};
+
+// centre_out_crossings: times the centre left the area (the start counts when
+// it starts outside); centre_out_spray_ml: volume delivered while it was out;
+// centre_out_close_s / centre_out_close_m: over the spells outside, the
+// longest time, and the centre's travel over it, from leaving the area to the
+// last sample that delivered anything (0 when nothing was delivered outside);
+// centre_out_samples: samples with the centre outside. Throws
+// std::invalid_argument naming the sample for a non-finite value, a negative
+// volume or time going back.
+std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples,
+                                                  const field2d::Polygon& area);
 
 // ---------------------------------------------------------------- flow per duty (Table 3)
 

@@ -132,6 +132,14 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                     trace.drain(t, round);
                 });
                 master.set_watchdog([&] { check_run(spec, wall, dds, trace, now_ns); });
+                // A role declared in a hello fails the case before time starts (harness/judge.h).
+                master.set_after_hello([](const std::vector<LockstepMaster::HelloTopics>& hellos) {
+                    for (const LockstepMaster::HelloTopics& hello : hellos) {
+                        if (const auto why = declared_role_violation(hello.subscribed, hello.published)) {
+                            throw NodeFailure(FailureKind::topic_role_violation, hello.node, *why);
+                        }
+                    }
+                });
                 try {
                     master.start();
                     startup_wall_s = wall.elapsed_s();

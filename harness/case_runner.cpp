@@ -166,15 +166,23 @@ private:
     CaseClock* clock_;
 };
 
-// Topics the controller said in its hello it writes that the rig has no type
-// for (its own diagnostics): recorded as raw samples, so they are matched,
-// counted and kept like any other. A topic it may not write at all is left to
-// the role check, which fails the case.
-void record_own_topics(const std::vector<std::string>& topics, TraceRecorder& trace, Watchdog& watchdog) {
+// What the controller said in its hello. A topic it may not read or write
+// fails the case here, before time starts: the same point in every run, where
+// discovery would tell it whenever its announcement happened to arrive (and
+// the trace would hold a varying part of the first instant). Topics it writes
+// that the rig has no type for (its own diagnostics) are recorded as raw
+// samples, so they are matched, counted and kept like any other.
+void check_hello_topics(const std::vector<LockstepMaster::HelloTopics>& hellos, TraceRecorder& trace,
+                        Watchdog& watchdog) {
+    for (const LockstepMaster::HelloTopics& hello : hellos) {
+        if (const auto why = declared_role_violation(hello.subscribed, hello.published)) {
+            throw NodeFailure(FailureKind::topic_role_violation, hello.node, *why);
+        }
+    }
     std::set<std::string> unknown;
-    for (const std::string& topic : topics) {
-        if (!trace.records(topic) && topic != topics::kClockAck && !topic_role_violation("writer", topic)) {
-            unknown.insert(topic);
+    for (const LockstepMaster::HelloTopics& hello : hellos) {
+        for (const std::string& topic : hello.published) {
+            if (!trace.records(topic) && topic != topics::kClockAck) unknown.insert(topic);
         }
     }
     const WallStopwatch waited;
@@ -243,7 +251,9 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         trace.drain(t, round);
     });
     master.set_watchdog([&watchdog] { watchdog(); });
-    master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
+    master.set_after_hello([&](const std::vector<LockstepMaster::HelloTopics>& hellos) {
+        check_hello_topics(hellos, trace, watchdog);
+    });
     try {
         master.start();
         facts.startup_wall_seconds = wall.elapsed_s();
@@ -293,7 +303,9 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
         board_silence.check(t);
     });
     master.set_watchdog([&watchdog] { watchdog(); });
-    master.set_after_hello([&](const std::vector<std::string>& topics) { record_own_topics(topics, trace, watchdog); });
+    master.set_after_hello([&](const std::vector<LockstepMaster::HelloTopics>& hellos) {
+        check_hello_topics(hellos, trace, watchdog);
+    });
     master.set_lateness_bound(spec.realtime);
     if (spec.rig_faults) {
         master.inject_stall(seconds_to_ns(spec.rig_faults->master_stall_at_s),
@@ -413,6 +425,12 @@ std::vector<CaseInstance> expand_runs(const std::vector<CaseSpec>& specs, const 
     std::vector<CaseInstance> runs;
     for (std::size_t i = 0; i < specs.size(); ++i) {
         const CaseSpec& spec = specs[i];
+        if (!options.seed_sweep.empty()) {
+            for (std::uint64_t seed : options.seed_sweep) {
+                runs.push_back(CaseInstance{i, seed, spec.name + "-seed" + std::to_string(seed)});
+            }
+            continue;
+        }
         if (spec.seeds.empty()) {
             runs.push_back(CaseInstance{i, options.seed_override.value_or(spec.seed), spec.name});
             continue;
@@ -545,6 +563,7 @@ std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOpti
             runs[i] = run_case(spec, instance.seed, instance.name, case_options);
         }
         observer.case_finished(i, runs[i].result);
+        if (!options.keep_figures) runs[i].figures = CaseFigures{};
     };
     // Lockstep cases share the machine; a real-time case runs alone, after them,
     // so that other cases' load does not become its scheduling jitter.

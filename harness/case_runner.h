@@ -42,6 +42,12 @@ struct RunOptions {
     // `rig run --in-process`: every case whose controller can runs in process
     // (a case's own controller.in_process wins).
     bool in_process = false;
+    // `rig sweep --seeds N`: every case runs once per seed here, as NAME-seedN
+    // (a case's own seed or `seeds:` and --seed are then not used).
+    std::vector<std::uint64_t> seed_sweep;
+    // false: run_cases drops each run's figures as it ends (a sweep of
+    // thousands of runs keeps only their numbers).
+    bool keep_figures = true;
     // `rig run --dds-security`: the run's credentials (OUT/security,
     // harness/dds_security_setup.h); the rig's participants hold its rig
     // identity, the controller process is given the controller's. nullopt: none.

@@ -471,6 +471,33 @@ std::map<std::string, double> read_limits(const YamlSection& section) {
     return limits;
 }
 
+PaperPoints read_paper(const YamlSection& section) {
+    PaperPoints paper;
+    for (const std::string& name : section.keys()) {
+        if (name == "source") continue;
+        if (name.size() > 64) {
+            throw ConfigError(section.key_location(name), "metric name of " + std::to_string(name.size()) +
+                                                              " characters, at most 64");
+        }
+        if (const std::string problem = metric_name_problem(name); !problem.empty()) {
+            throw ConfigError(section.key_location(name), problem);
+        }
+        // The same range as a limit: the paper's numbers are of the same metrics.
+        paper.values[name] = section.required_in_range<double>(name, Bounds::closed(-1e6, 1e6));
+    }
+    if (section.has("source")) {
+        paper.source = section.required<std::string>("source");
+        if (paper.source.empty() || paper.source.size() > 200) {
+            section.fail("source", "where in the paper the numbers are, in at most 200 characters (e.g. \"Table 2\")");
+        }
+    }
+    if (!paper.values.empty() && paper.source.empty()) {
+        throw ConfigError(section.key_location(paper.values.begin()->first),
+                          "the paper's numbers need a source: where in the paper they are (paper.source)");
+    }
+    return paper;
+}
+
 ExpectSpec read_expect(const YamlSection& section) {
     ExpectSpec expect;
     expect.fail = section.string_list("fail");
@@ -647,6 +674,7 @@ CaseSpec read_boundary_system_case(const YamlSection& root, CaseSpec spec) {
     }
     spec.controller.params = controller_section_with_area(spec.controller.params, *boundary);
     spec.limits = read_limits(root.section("limits"));
+    spec.paper = read_paper(root.section("paper"));
     spec.expect = read_expect(root.section("expect"));
     spec.timeouts = read_timeouts(root.section("timeouts"));
     root.finish();
@@ -735,6 +763,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.rig_faults = read_rig_faults(root.section("rig_faults"));
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
+    spec.paper = read_paper(root.section("paper"));
     spec.expect = read_expect(root.section("expect"));
     spec.timeouts = read_timeouts(root.section("timeouts"));
 

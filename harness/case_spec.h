@@ -293,6 +293,13 @@ inline constexpr std::size_t kMaxCaseNameLength = 100;
 // Free text, printed in reports.
 inline constexpr std::size_t kMaxDescriptionLength = 2000;
 
+// The paper's numbers for a case (`paper: { source: "Table 2, 20 L/min", flow_adjust_time_s: 1.286 }`):
+// where they come from, and a value per metric, under the metrics' own names.
+struct PaperPoints {
+    std::string source;                    // e.g. "Table 2 (20 L/min group)"; required when values are given
+    std::map<std::string, double> values;  // metric name -> the paper's value, in the metric's unit
+};
+
 struct CaseSpec {
     std::filesystem::path source_path;
     std::string name;  // required, see kMaxCaseNameLength
@@ -338,6 +345,10 @@ struct CaseSpec {
     std::map<std::string, double> limits;
     ExpectSpec expect;
     TimeoutsSpec timeouts;
+    // `paper:` the paper's own numbers for this case's metrics, as data: a rig
+    // sweep draws them over the rig's bands (harness/sweep.h). Not a limit and
+    // never part of the verdict.
+    PaperPoints paper;
 };
 
 // Limits every case gets unless its file overrides them (docs/metrics.md),

@@ -1,6 +1,7 @@
 // `rig`: the rig's one command line (README "Running cases", `rig --help`).
 //   rig --version
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N] [--quiet | --verbose]
+//   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N] [--in-process]
 //   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--dds-security] [--out DIR]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <map>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <unistd.h>
@@ -41,6 +43,7 @@
 #include "rig/runtime/clock.h"
 #include "rig/config/config_error.h"
 #include "harness/speed_bench.h"
+#include "harness/sweep.h"
 #include "rig/host/dds_check.h"
 #include "rig/host/shm_cleanup.h"
 #include "rig/host/dds_pingpong.h"
@@ -54,8 +57,11 @@ std::filesystem::path own_directory() {
     return error ? std::filesystem::current_path() : self.parent_path();
 }
 
-int run_command(const std::vector<std::string>& inputs, const rig::harness::RunOptions& options,
-                const std::optional<rig::harness::Shard>& shard, rig::harness::Verbosity verbosity) {
+// Every case file read and validated before anything starts (the errors go to
+// standard error, and nothing is run: nullopt).
+std::optional<std::vector<rig::harness::CaseSpec>> load_cases(const std::vector<std::string>& inputs,
+                                                              const rig::harness::RunOptions& options,
+                                                              const std::optional<rig::harness::Shard>& shard) {
     using namespace rig::harness;
     std::vector<CaseSpec> specs;
     try {
@@ -92,7 +98,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         if (!errors.empty()) {
             for (const auto& error : errors) std::cerr << "rig: " << error << "\n";
             std::cerr << "rig: " << errors.size() << " case file error(s); nothing was run\n";
-            return 2;
+            return std::nullopt;
         }
         // Every file was checked above, whichever shard it is in: a broken case fails every shard's job.
         if (shard) {
@@ -103,14 +109,21 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
         }
     } catch (const std::exception& error) {
         std::cerr << "rig: " << error.what() << "\n";
-        return 2;
+        return std::nullopt;
     }
-    // An output directory that cannot take results is refused now, not after the cases ran.
+    return specs;
+}
+
+// Refuses an output directory that cannot take results (before any case runs),
+// makes the run's DDS-Security credentials if asked, then removes what killed
+// participants of earlier runs left in /dev/shm.
+bool prepare_run(const rig::harness::RunOptions& options) {
+    using namespace rig::harness;
     try {
         prepare_output_directory(options.out_dir);
     } catch (const OutputDirError& error) {
         std::cerr << "rig: " << error.what() << "; nothing was run\n";
-        return 2;
+        return false;
     }
     // --dds-security: this run's credentials, before any participant exists
     // (docs/dds-security.md); every participant of the rig's holds its identity.
@@ -120,31 +133,46 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
             rig::use_dds_security_identity(credentials.identity_dir(kRigIdentity));
         } catch (const std::exception& error) {
             std::cerr << "rig: --dds-security: " << error.what() << "; nothing was run\n";
-            return 2;
+            return false;
         }
     }
-    // What killed participants of earlier runs left in /dev/shm (rig/host/shm_cleanup.h).
     if (const rig::ShmCleanup cleaned = rig::remove_dead_participant_segments(); !cleaned.removed.empty()) {
         std::cerr << "rig: removed " << cleaned.removed.size() << " Fast DDS shared-memory segment(s) ("
                   << cleaned.bytes_freed / 1024 << " KiB) of participants that were killed, from "
                   << rig::kPosixShmDir.string() << "\n";
     }
+    return true;
+}
+
+// Progress on standard error: a status line kept up to date on a terminal, a
+// line per case elsewhere (a CI log); nothing with --quiet.
+std::unique_ptr<rig::harness::RunObserver> progress_observer(rig::harness::Verbosity verbosity, int jobs,
+                                                             rig::harness::TerminalProgress*& terminal) {
+    using namespace rig::harness;
+    terminal = nullptr;
+    if (verbosity != Verbosity::quiet && isatty(STDERR_FILENO) != 0) {
+        auto progress = std::make_unique<TerminalProgress>(std::cerr, verbosity, jobs, terminal_width(STDERR_FILENO));
+        terminal = progress.get();
+        return progress;
+    }
+    return std::make_unique<CaseLineLog>(std::cerr, verbosity);
+}
+
+int run_command(const std::vector<std::string>& inputs, const rig::harness::RunOptions& options,
+                const std::optional<rig::harness::Shard>& shard, rig::harness::Verbosity verbosity) {
+    using namespace rig::harness;
+    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, shard);
+    if (!loaded) return 2;
+    const std::vector<CaseSpec>& specs = *loaded;
+    // An output directory that cannot take results is refused now, not after the cases ran.
+    if (!prepare_run(options)) return 2;
     // SIGINT / SIGTERM from here on stop the cases, not the rig: the results of
     // what ran are still written (harness/run_interrupt.h).
     install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
     const std::string started_utc = rig::utc_date_time_now();
-    // Progress on standard error: a status line kept up to date on a terminal,
-    // a line per case elsewhere (a CI log); nothing with --quiet.
-    std::unique_ptr<RunObserver> observer;
     TerminalProgress* terminal = nullptr;
-    if (verbosity != Verbosity::quiet && isatty(STDERR_FILENO) != 0) {
-        auto progress = std::make_unique<TerminalProgress>(std::cerr, verbosity, options.jobs, terminal_width(STDERR_FILENO));
-        terminal = progress.get();
-        observer = std::move(progress);
-    } else {
-        observer = std::make_unique<CaseLineLog>(std::cerr, verbosity);
-    }
+    const std::unique_ptr<RunObserver> observer = progress_observer(verbosity, options.jobs, terminal);
     const auto runs = run_cases(specs, options, *observer);
     if (terminal != nullptr) terminal->finish();
     std::vector<CaseResult> results;
@@ -202,6 +230,104 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     // (the rig was overloaded: docs/metrics.md "Verdicts"); run it again.
     if (summary.failed > 0) return 1;
     return summary.invalid > 0 ? 3 : 0;
+}
+
+// Forwards to the progress display, and removes each run's trace once it is
+// judged unless the sweep keeps it (`--keep-traces`): a sweep of thousands of
+// runs keeps numbers, and the traces worth opening.
+class SweepTraceKeeper final : public rig::harness::RunObserver {
+public:
+    SweepTraceKeeper(rig::harness::RunObserver& progress, std::string keep) : progress_(progress), keep_(std::move(keep)) {}
+    void runs_planned(const std::vector<rig::harness::CaseInstance>& runs,
+                      const std::vector<rig::harness::CaseSpec>& specs) override {
+        progress_.runs_planned(runs, specs);
+    }
+    void case_started(std::size_t index) override { progress_.case_started(index); }
+    void case_finished(std::size_t index, const rig::harness::CaseResult& result) override {
+        progress_.case_finished(index, result);
+        const bool keep = keep_ == "all" || (keep_ == "failed" && !rig::harness::case_passed(result));
+        if (keep || result.trace_path.empty()) return;
+        std::error_code ignored;
+        std::filesystem::remove(result.trace_path, ignored);
+    }
+    rig::harness::CaseClock* case_clock(std::size_t index) override { return progress_.case_clock(index); }
+
+private:
+    rig::harness::RunObserver& progress_;
+    std::string keep_;
+};
+
+struct SweepArguments {
+    std::uint64_t seeds = 0;
+    std::uint64_t first_seed = 1;
+    std::string keep_traces = "failed";
+};
+
+int sweep_command(const std::vector<std::string>& inputs, rig::harness::RunOptions options, const SweepArguments& sweep,
+                  rig::harness::Verbosity verbosity) {
+    using namespace rig::harness;
+    if (sweep.first_seed > std::numeric_limits<std::uint64_t>::max() - (sweep.seeds - 1)) {
+        std::cerr << "rig sweep: --first-seed " << sweep.first_seed << " with --seeds " << sweep.seeds
+                  << " passes the largest seed (2^64 - 1)\n";
+        return 2;
+    }
+    for (std::uint64_t k = 0; k < sweep.seeds; ++k) options.seed_sweep.push_back(sweep.first_seed + k);
+    options.keep_figures = false;
+    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, std::nullopt);
+    if (!loaded) return 2;
+    const std::vector<CaseSpec>& specs = *loaded;
+    for (const CaseSpec& spec : specs) {
+        if (spec.mode == RunMode::realtime) {
+            std::cerr << "rig sweep: " << spec.source_path.string()
+                      << ": a real-time case runs on the wall clock, so " << sweep.seeds
+                      << " seeds would take that many times its length; sweep lockstep cases (rig run takes --seed)\n";
+            return 2;
+        }
+    }
+    if (!prepare_run(options)) return 2;
+    install_run_interrupt_handlers();
+    const rig::WallStopwatch wall;
+    SweepInfo info;
+    info.started_utc = rig::utc_date_time_now();
+    info.seeds = options.seed_sweep;
+    info.keep_traces = sweep.keep_traces;
+    info.controller_mode = options.in_process ? "in_process" : "process";
+    TerminalProgress* terminal = nullptr;
+    const std::unique_ptr<RunObserver> progress = progress_observer(verbosity, options.jobs, terminal);
+    SweepTraceKeeper keeper(*progress, sweep.keep_traces);
+    const std::vector<CaseRun> runs = run_cases(specs, options, keeper);
+    if (terminal != nullptr) terminal->finish();
+    std::vector<CaseResult> results;
+    bool all_passed = true;
+    for (const CaseRun& run : runs) {
+        results.push_back(run.result);
+        info.sim_seconds += run.result.sim_seconds;
+        all_passed = all_passed && case_passed(run.result);
+    }
+    info.wall_seconds = wall.elapsed_s();
+    const std::vector<CaseInstance> instances = expand_runs(specs, options);
+    const std::vector<CaseSweep> cases = summarize_sweep(specs, instances, results);
+    const std::string table = sweep_table(cases, info);
+    try {
+        write_file_atomically(options.out_dir / "sweep.json", sweep_json(cases, instances, results, info).dump(1) + "\n");
+        write_file_atomically(options.out_dir / "sweep.txt", table);
+        write_file_atomically(options.out_dir / "sweep.html", sweep_html(cases, info));
+    } catch (const std::exception& error) {
+        std::cout << table;
+        std::cerr << "rig sweep: results not written: " << error.what() << "\n";
+        return kExitResultsNotWritten;
+    }
+    if (verbosity == Verbosity::quiet) {
+        std::cout << table.substr(table.rfind('\n', table.size() - 2) + 1);
+    } else {
+        std::cout << table << "sweep: " << (options.out_dir / "sweep.json").string() << ", "
+                  << (options.out_dir / "sweep.txt").string() << ", " << (options.out_dir / "sweep.html").string() << "\n";
+    }
+    if (const int signal = run_interrupt_signal()) {
+        std::cerr << "rig sweep: interrupted by signal " << signal << "; the runs that ended are in the sweep\n";
+        return 128 + signal;
+    }
+    return all_passed ? 0 : 1;
 }
 
 int nmea_decode_command(const std::string& input) {
@@ -342,6 +468,28 @@ int main(int argc, char** argv) {
     merge->add_option("shard_outs", merge_options.shard_dirs, "the shards' rig run --out directories")->required();
     merge->add_option("--out", merge_options.out_dir, "the merged run directory (new or empty)")->required();
 
+    rig::harness::RunOptions sweep_options = run_options;
+    sweep_options.out_dir = "rig-sweep";
+    std::vector<std::string> sweep_inputs;
+    SweepArguments sweep_arguments;
+    auto* sweep = app.add_subcommand(
+        "sweep", "run lockstep cases over many seeds: every metric's p5 / p50 / p95 / max against its limit and the paper");
+    sweep->add_option("cases", sweep_inputs, "lockstep case files or directories")->required();
+    sweep->add_option("--seeds", sweep_arguments.seeds, "seeds per case (1 .. 100000)")
+        ->required()
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{100000}));
+    sweep->add_option("--first-seed", sweep_arguments.first_seed, "the first seed (default 1); seeds run N, N+1, ...")
+        ->check(rig::harness::unsigned_decimal_check());
+    sweep->add_option("--keep-traces", sweep_arguments.keep_traces,
+                      "which runs keep their trace: failed (default), all or none")
+        ->check(CLI::IsMember({"failed", "all", "none"}));
+    sweep->add_option("--out", sweep_options.out_dir, "output directory (sweep.json, sweep.txt, sweep.html, runs)");
+    sweep->add_option("--jobs", sweep_options.jobs, "runs at once, each on its own DDS domain")->check(CLI::Range(1, 16));
+    sweep->add_flag("--in-process", sweep_options.in_process,
+                    "software-in-the-loop, as rig run --in-process (same digests, several times faster)");
+    bool sweep_quiet = false;
+    sweep->add_flag("--quiet,-q", sweep_quiet, "print only the summary line: no progress, no table");
+
     auto* nmea = app.add_subcommand("nmea", "NMEA tools");
     nmea->require_subcommand(1);
     std::string nmea_input;
@@ -421,6 +569,10 @@ int main(int argc, char** argv) {
                                : run_verbose ? rig::harness::Verbosity::verbose
                                              : rig::harness::Verbosity::normal;
         return run_command(case_inputs, run_options, shard, verbosity);
+    }
+    if (sweep->parsed()) {
+        return sweep_command(sweep_inputs, sweep_options, sweep_arguments,
+                             sweep_quiet ? rig::harness::Verbosity::quiet : rig::harness::Verbosity::normal);
     }
     if (judge->parsed()) return rig::harness::run_judge_command(judge_options, std::cout, std::cerr);
     if (merge->parsed()) return rig::harness::run_merge_command(merge_options, std::cout, std::cerr);

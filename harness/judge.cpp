@@ -291,6 +291,17 @@ std::optional<std::string> topic_role_violation(const std::string& endpoint, con
     return std::nullopt;
 }
 
+std::optional<std::string> declared_role_violation(const std::vector<std::string>& subscribed,
+                                                   const std::vector<std::string>& published) {
+    for (const std::string& topic : subscribed) {
+        if (auto why = topic_role_violation("reader", topic)) return *why + " (declared in its hello)";
+    }
+    for (const std::string& topic : published) {
+        if (auto why = topic_role_violation("writer", topic)) return *why + " (declared in its hello)";
+    }
+    return std::nullopt;
+}
+
 // ---------------------------------------------------------------- judging
 
 namespace {

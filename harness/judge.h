@@ -103,5 +103,11 @@ CaseRun judge_trace(const RecordedTrace& trace);
 // read or write truth/*, nor write device/* or the clock's tick. Returns why an
 // endpoint breaks its role ("reads truth topic truth/vehicle"), or nullopt.
 std::optional<std::string> topic_role_violation(const std::string& endpoint, const std::string& topic);
+// The same for what a node declared in its hello (the topics it reads and
+// writes): why the first one breaks its role, or nullopt. Checked when the
+// hellos arrive, before time starts, so a node that declares a forbidden topic
+// fails at the same point in every run.
+std::optional<std::string> declared_role_violation(const std::vector<std::string>& subscribed,
+                                                   const std::vector<std::string>& published);
 
 }  // namespace rig::harness

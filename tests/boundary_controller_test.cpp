@@ -146,6 +146,17 @@ TEST(BoundaryController, Rule2TheBoomCentreOutsideTurnsAllOff) {
     EXPECT_TRUE(c.status().nozzles[0].inside);
 }
 
+TEST(BoundaryController, TheCentreRuleFaultSpraysTheInsideNozzlesWithTheCentreOutside) {
+    // The same place as Rule2TheBoomCentreOutsideTurnsAllOff with the TEST-ONLY
+    // fault: nozzles 0 and 1 (19.05, 19.55 m) spray though the centre is out.
+    BoundaryControllerConfig config = square_config();
+    config.faults.ignore_centre_rule = true;
+    BoundaryController c(config);
+    const std::vector<double> d = duties_at(c, {20.3, 10.0}, 0.0, 1.5, 0.0);
+    EXPECT_EQ(d, (std::vector<double>{100, 100, 0, 0, 0, 0}));
+    EXPECT_FALSE(c.status().centre_inside);
+}
+
 TEST(BoundaryController, DrivingOutAcrossTheEdgeShutsAllAtTheFixPastIt) {
     // North at 1.5 m/s at east 10, fixes every 0.1 s (0.15 m): the boom centre,
     // 1.0 m ahead of the antenna, passes north = 20 between the antenna at 18.95

@@ -144,6 +144,70 @@ TEST(BoundaryMetrics, BadInputIsRejected) {
     EXPECT_THROW(sum_rasters({raster_where([](double, double) { return false; }), other}), std::invalid_argument);
 }
 
+// The square east 0 ... 10, north 0 ... 10; the centre drives north along
+// east = 10 + offset at 1 m/s, sampled every 0.1 s, each sample delivering 1 mL
+// while `open(t)` says so.
+template <class Offset, class Open>
+std::vector<CentreRuleSample> along_east_edge(Offset offset_m, double from_s, double to_s, Open open) {
+    std::vector<CentreRuleSample> samples;
+    for (int k = 0; from_s + 0.1 * k <= to_s + 1e-9; ++k) {
+        const double t = from_s + 0.1 * k;
+        samples.push_back(CentreRuleSample{t, {10.0 + offset_m(t), t}, open(t) ? 0.001 : 0.0});
+    }
+    return samples;
+}
+
+const rig::field2d::Polygon kSquare({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, "square");
+
+TEST(CentreRuleMetrics, AllOffWithTheCentreOutsideScoresZero) {
+    // The centre 0.2 m outside all along, nothing delivered: the start counts as one spell.
+    const auto m = centre_rule_metrics(along_east_edge([](double) { return 0.2; }, 0.0, 8.0, [](double) { return false; }), kSquare);
+    EXPECT_EQ(m.at("centre_out_crossings"), 1.0);
+    EXPECT_EQ(m.at("centre_out_samples"), 81.0);
+    EXPECT_EQ(m.at("centre_out_spray_ml"), 0.0);
+    EXPECT_EQ(m.at("centre_out_close_s"), 0.0);
+    EXPECT_EQ(m.at("centre_out_close_m"), 0.0);
+}
+
+TEST(CentreRuleMetrics, ClosingLateAfterTheCentreCrossesOutIsMeasuredFromTheCrossing) {
+    // Inside (east 9.8) until t = 3, outside (10.2) after; the spray stops at
+    // t = 3.3 (last delivering sample 3.3): 0.3 s, the centre's travel 0.3 m
+    // along plus nothing across (it jumped out between samples), 3 samples x 1 mL.
+    const auto m = centre_rule_metrics(
+        along_east_edge([](double t) { return t < 3.0 - 1e-9 ? -0.2 : 0.2; }, 0.0, 6.0, [](double t) { return t < 3.35; }),
+        kSquare);
+    EXPECT_EQ(m.at("centre_out_crossings"), 1.0);
+    EXPECT_NEAR(m.at("centre_out_close_s"), 0.3, 1e-9);
+    EXPECT_NEAR(m.at("centre_out_close_m"), 0.3, 1e-9);
+    EXPECT_NEAR(m.at("centre_out_spray_ml"), 4.0, 1e-9);  // t = 3.0, 3.1, 3.2, 3.3
+    // A controller that ignores the rule sprays all the way: the longest spell's 3 s.
+    const auto ignored = centre_rule_metrics(
+        along_east_edge([](double t) { return t < 3.0 - 1e-9 ? -0.2 : 0.2; }, 0.0, 6.0, [](double) { return true; }),
+        kSquare);
+    EXPECT_NEAR(ignored.at("centre_out_close_s"), 3.0, 1e-9);
+    EXPECT_NEAR(ignored.at("centre_out_spray_ml"), 31.0, 1e-9);
+}
+
+TEST(CentreRuleMetrics, TheLongestOfSeveralSpellsCountsAndBadInputIsNamed) {
+    // Out 1-2 s (spray until 1.2), in, out 4-6 s (spray until 4.5).
+    const auto out = [](double t) { return (t > 0.95 && t < 2.05) || t > 3.95 ? 0.2 : -0.2; };
+    const auto open = [](double t) { return t < 1.25 || (t > 2.5 && t < 4.55); };
+    const auto m = centre_rule_metrics(along_east_edge(out, 0.0, 6.0, open), kSquare);
+    EXPECT_EQ(m.at("centre_out_crossings"), 2.0);
+    EXPECT_NEAR(m.at("centre_out_close_s"), 0.5, 1e-9);
+    std::vector<CentreRuleSample> bad = along_east_edge(out, 0.0, 1.0, open);
+    bad[3].volume_l = -1.0;
+    try {
+        centre_rule_metrics(bad, kSquare);
+        FAIL() << "a negative volume passed";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("sample 3"), std::string::npos) << e.what();
+    }
+    bad[3].volume_l = 0.0;
+    bad[5].t_s = 0.1;
+    EXPECT_THROW(centre_rule_metrics(bad, kSquare), std::invalid_argument);
+}
+
 TEST(FlowMetrics, DeliveredAgainstTable3) {
     const auto table = rig::field2d::NozzleFlowTable::paper_table3();
     // Nozzle 0 at 40 %: 0.390 L in 60 s is Table 3's 390 mL/min; nozzle 3 at

@@ -3,13 +3,33 @@
 // node's readers and writers must then neither touch the freed context nor
 // leak DDS entities (the SDK example and the boundary controller once did the
 // former; ASan saw it). Runs under ASan in CI like every test.
+//
+// And a writer whose reader died with samples unacknowledged: deleting it must
+// return. Fast DDS 2.9's StatefulWriter destructor frees the history's changes
+// one by one while its periodic heartbeat may still walk that history; a freed
+// change's sequence number sends add_gaps_for_holes_in_history_ counting towards
+// 2^64 with the writer's mutex held, and the destructor waits on that mutex for
+// ever (seen as a hung `rig run` after a controller crashed mid-case).
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <fcntl.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <future>
 #include <memory>
+#include <string>
 
 #include "idl/topics.h"
 #include "rig/host/domain_lease.h"
 #include "rig/runtime/dds_context.h"
+#include "rig/runtime/realtime.h"
+#include "run_support.h"
 
 namespace {
 
@@ -46,6 +66,77 @@ TEST(DdsContext, EndpointsDestroyedFirstLeaveTheRegistry) {
     }
     EXPECT_TRUE(dds.writers().empty());
     EXPECT_TRUE(dds.readers().empty());
+}
+
+// The reference controller as a reader of the wheel encoder: it makes its
+// participant and endpoints, then waits for a master that never comes.
+pid_t spawn_encoder_reader(const std::filesystem::path& dir, int domain_id) {
+    std::ofstream(dir / "controller.yaml") << "positioning: fusion\n";
+    std::filesystem::create_directories(dir / "state");
+    const std::string log_path = (dir / "controller.log").string();
+    const std::string config_path = (dir / "controller.yaml").string();
+    const std::string state_path = (dir / "state").string();
+    const std::string domain = std::to_string(domain_id);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+        ::dup2(log, 1);
+        ::dup2(log, 2);
+        ::execl(RIG_BINARY_DIR "/bin/rig-controller", "rig-controller", "--domain", domain.c_str(), "--config",
+                config_path.c_str(), "--state-dir", state_path.c_str(), nullptr);
+        ::_exit(127);
+    }
+    return pid;
+}
+
+TEST(DdsContext, DeletingAWriterWhoseReaderDiedWithSamplesUnacknowledgedReturns) {
+    const std::filesystem::path dir = rig::testing::fresh_dir("dds-context-dead-reader");
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    auto dds = std::make_unique<rig::DdsContext>(lease.domain_id(), "writer-of-a-dead-reader");
+    const pid_t reader = spawn_encoder_reader(dir, lease.domain_id());
+    ASSERT_GT(reader, 0);
+    rig::RealtimeClock clock;
+    // Several writers, each deleted with a full history: the race with the
+    // heartbeat (every 0.2 ms while anything is unacknowledged) is lost on
+    // almost every deletion without the fix.
+    constexpr int kWriters = 8;
+    std::vector<std::unique_ptr<rig::Writer<rig::msg::EncoderCount>>> writers;
+    for (int i = 0; i < kWriters; ++i) {
+        writers.push_back(std::make_unique<rig::Writer<rig::msg::EncoderCount>>(*dds, rig::topics::kWheelEncoder));
+    }
+    // Bounded by the controller's start-up, not a speed assertion.
+    for (int i = 0; i < 6000; ++i) {
+        bool all_matched = true;
+        for (const auto& writer : writers) all_matched = all_matched && writer->matched_readers() >= 1;
+        if (all_matched) break;
+        clock.sleep_until_ns(clock.now_ns() + rig::seconds_to_ns(0.01));
+    }
+    for (const auto& writer : writers) {
+        ASSERT_GE(writer->matched_readers(), 1) << rig::testing::read_all(dir / "controller.log");
+    }
+    ::kill(reader, SIGKILL);
+    ::waitpid(reader, nullptr, 0);
+
+    rig::msg::EncoderCount sample;
+    for (auto& writer : writers) {
+        for (int n = 0; n < 2000; ++n) {
+            sample.count_pulses(static_cast<std::uint32_t>(n));
+            writer->publish(sample);
+        }
+    }
+    // The reader's participant is still matched (its lease has not run out), so
+    // all of it stays unacknowledged in each writer's history. Half the writers
+    // go by their own destructor, the other half with their context.
+    auto deleted = std::async(std::launch::async, [&writers, &dds] {
+        writers.resize(kWriters / 2);
+        dds.reset();
+        writers.clear();
+    });
+    if (deleted.wait_for(std::chrono::seconds(120)) != std::future_status::ready) {
+        // The deleting thread is stuck inside Fast DDS and cannot be joined.
+        std::fprintf(stderr, "deleting writers whose reader died did not return in 120 s\n");
+        std::_Exit(1);
+    }
 }
 
 }  // namespace

@@ -197,4 +197,26 @@ TEST(FaultyControllers, ANoCompensationControllerWithoutItsExpectationFailsTheRu
         << only.dump(2);
 }
 
+// A controller that declares a truth topic in its hello fails when the hellos
+// arrive at the latest, before time starts: on every run with no instant run, so the same trace
+// (when discovery told it, the trace held 0 or 13 samples of the first instant
+// depending on when the announcement arrived).
+TEST(FaultyControllers, ADeclaredForgedTopicFailsBeforeTimeStartsWithTheSameTraceEveryRun) {
+    const fs::path out = fresh_dir("declared-forgery");
+    std::string digest;
+    for (int run = 0; run < 4; ++run) {
+        const fs::path dir = out / ("run" + std::to_string(run));
+        const int status = rig_run(kCatalogue / "forges-truth-topic.yaml", dir, out / "rig.log", "--seed 2");
+        ASSERT_EQ(status, 0) << read_all(out / "rig.log");
+        const nlohmann::json only = load_results(dir).at("cases").at(0);
+        // Discovery may still tell it first, while the rig waits for the hellos:
+        // before time starts too.
+        EXPECT_NE(only.at("error").get<std::string>().find("writes truth topic truth/hydraulics"), std::string::npos)
+            << only.dump(2);
+        EXPECT_EQ(only.at("rounds"), 0) << only.dump(2);
+        if (run == 0) digest = only.at("trace_sha256").get<std::string>();
+        EXPECT_EQ(only.at("trace_sha256").get<std::string>(), digest) << "run " << run;
+    }
+}
+
 }  // namespace

@@ -64,7 +64,9 @@ TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
     const fs::path out = fresh_dir("verdicts");
     const std::string files = "'" + (kCases / "seed001-table8-boundary" / "drive-out.yaml").string() + "' '" +
                               (kCases / "seed001-faulty-controllers" / "wrong-antenna-offset.yaml").string() + "' '" +
-                              (kCases / "seed001-faulty-controllers" / "no-course-rotation.yaml").string() + "'";
+                              (kCases / "seed001-faulty-controllers" / "no-course-rotation.yaml").string() + "' '" +
+                              (kCases / "seed001-table8-boundary" / "along-centre-outside.yaml").string() + "' '" +
+                              (kCases / "seed001-faulty-controllers" / "ignore-centre-rule.yaml").string() + "'";
     const int status = rig("run " + files + " --seed 1 --jobs 2 --out '" + (out / "run").string() + "'", out / "run.log");
     ASSERT_EQ(status, 0) << rig::testing::read_all(out / "run.log");
     const nlohmann::json results = load_results(out / "run");
@@ -89,6 +91,21 @@ TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
     const nlohmann::json& rotation = find_case(results, "seed001-faulty-no-course-rotation");
     EXPECT_TRUE(rotation.at("expected_failure").get<bool>()) << rotation.dump(2);
     EXPECT_EQ(failing_metrics(rotation), std::set<std::string>{"boundary_overrun_mean_m"});
+
+    // Table 8 "along, boom centre outside": Sec. 4.2's second rule keeps all
+    // six nozzles shut, though three are inside: nothing delivered, nothing wet.
+    const nlohmann::json& along = find_case(results, "seed001-table8-along-centre-outside-seed1");
+    EXPECT_TRUE(along.at("passed").get<bool>()) << along.dump(2);
+    EXPECT_EQ(along.at("metrics").at("centre_out_spray_ml").get<double>(), 0.0);
+    EXPECT_GT(along.at("metrics").at("centre_out_samples").get<double>(), 100.0);
+    EXPECT_EQ(along.at("metrics").at("boundary_overrun_stations_dry").get<double>(), 11.0);
+
+    // Without the rule the inside nozzles spray on after the centre has left,
+    // metres past the crossing: caught on centre_out_close_m.
+    const nlohmann::json& centre = find_case(results, "seed001-faulty-ignore-centre-rule");
+    EXPECT_TRUE(centre.at("expected_failure").get<bool>()) << centre.dump(2);
+    EXPECT_EQ(failing_metrics(centre), std::set<std::string>{"centre_out_close_m"});
+    EXPECT_GT(centre.at("metrics").at("centre_out_close_m").get<double>(), 2.0);
 
     // Every metric and verdict again from the traces alone.
     EXPECT_EQ(rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",

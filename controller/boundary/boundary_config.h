@@ -41,6 +41,10 @@ struct BoundaryControllerFaults {
     bool ignore_boom_height = false;
     // The look-ahead points taken behind the antenna instead of ahead.
     bool lookahead_sign_flipped = false;
+    // Sec. 4.2's second rule dropped: each nozzle judged on its own position
+    // only, so nozzles inside spray while the boom centre is outside (the
+    // headland double spray of spraying environment 2).
+    bool ignore_centre_rule = false;
 };
 
 struct BoundaryControllerConfig {

@@ -181,7 +181,9 @@ void BoundaryController::decide() {
         nozzle.inside = inside(x, nozzle_was_inside_[idx], nozzle.area);
         nozzle_was_inside_[idx] = nozzle.inside;
         nozzle.level = 0;
-        if (status_.centre_inside && nozzle.inside && nozzle.area >= 0) {
+        // Sec. 4.2: a nozzle sprays only while it and the boom centre are both inside.
+        const bool centre_allows = status_.centre_inside || faults.ignore_centre_rule;
+        if (centre_allows && nozzle.inside && nozzle.area >= 0) {
             const double density = areas_[static_cast<std::size_t>(nozzle.area)].density();
             nozzle.level = spray_level(config_, eq14_theoretical_duty_pct(config_, density, v));
         }

@@ -61,6 +61,7 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     c.faults.no_course_rotation = faults.optional<bool>("no_course_rotation", false);
     c.faults.ignore_boom_height = faults.optional<bool>("ignore_boom_height", false);
     c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
+    c.faults.ignore_centre_rule = faults.optional<bool>("ignore_centre_rule", false);
 
     const YamlSection sweep = section.section("calibration");
     const std::vector<std::string> duties = sweep.string_list("duties_pct");

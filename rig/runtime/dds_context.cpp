@@ -47,6 +47,23 @@ dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber) {
     return qos;
 }
 
+// Empties the writer's history before deleting it. Fast DDS 2.9.1's
+// StatefulWriter destructor releases the history's changes one by one, taking
+// and dropping the writer's mutex for each, while the periodic heartbeat (armed
+// while anything is unacknowledged: a reader that died mid-case leaves it so)
+// can take that mutex in between and walk a history of released changes; a
+// released change's sequence number sends add_gaps_for_holes_in_history_
+// counting towards 2^64 with the mutex held, and the destructor never gets it
+// back. clear_history removes the changes through the history, under the mutex,
+// so the heartbeat sees an empty history. Nothing written is lost: the writer is
+// going away, and a tick that needed it was acknowledged (or failed) before.
+void delete_writer(dds::Publisher& publisher, dds::DataWriter* writer) {
+    if (writer == nullptr) return;
+    std::size_t removed = 0;
+    writer->clear_history(&removed);
+    publisher.delete_datawriter(writer);
+}
+
 }  // namespace
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
@@ -60,11 +77,11 @@ WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* 
 WriterBase::~WriterBase() {
     if (context_ == nullptr) return;  // detached: the context deleted the DDS writer
     context_->unregister_writer(this);
-    context_->publisher().delete_datawriter(writer_);
+    delete_writer(context_->publisher(), writer_);
 }
 
 void WriterBase::detach() {
-    context_->publisher().delete_datawriter(writer_);
+    delete_writer(context_->publisher(), writer_);
     writer_ = nullptr;
     context_ = nullptr;
 }

@@ -154,11 +154,11 @@ void LockstepMaster::start() {
         // Hello: seq 0.
         tick_remotes(0, false);
         if (after_hello_) {
-            std::vector<std::string> published;
+            std::vector<HelloTopics> hellos;
             for (const Remote& remote : remotes_) {
-                published.insert(published.end(), remote.published_topics.begin(), remote.published_topics.end());
+                hellos.push_back(HelloTopics{remote.name, remote.subscribed_topics, remote.published_topics});
             }
-            after_hello_(published);
+            after_hello_(hellos);
         }
     }
 

@@ -94,11 +94,19 @@ public:
     // (a stop signal, its wall-time bound, topic roles seen in discovery) and
     // throws NodeFailure to end the run.
     void set_watchdog(std::function<void()> callback) { watchdog_ = std::move(callback); }
-    // Called once the remotes answered the hello, with every topic they said they
-    // write, before the endpoints are matched: the recorder adds readers for
-    // topics it does not know yet (a controller's own diagnostics), so that they
-    // are matched and counted like the others.
-    void set_after_hello(std::function<void(const std::vector<std::string>&)> callback) {
+    // What a remote node said in its hello: the topics it reads and writes.
+    struct HelloTopics {
+        std::string node;
+        std::vector<std::string> subscribed;
+        std::vector<std::string> published;
+    };
+    // Called once the remotes answered the hello, with what each said it reads
+    // and writes, before time starts and before the endpoints are matched: the
+    // harness checks the roles declared there (a node that says it reads truth
+    // fails here, at the same point every run, not whenever discovery happens
+    // to tell), and the recorder adds readers for topics it does not know yet
+    // (a controller's own diagnostics), so that they are matched and counted.
+    void set_after_hello(std::function<void(const std::vector<HelloTopics>&)> callback) {
         after_hello_ = std::move(callback);
     }
 
@@ -166,7 +174,7 @@ private:
     std::unique_ptr<Reader<msg::ClockAck>> ack_reader_;
     std::function<void(TimeNs, int)> after_round_;
     std::function<void()> watchdog_;
-    std::function<void(const std::vector<std::string>&)> after_hello_;
+    std::function<void(const std::vector<HelloTopics>&)> after_hello_;
     std::uint64_t seq_ = 0;
     TimeNs now_ns_ = 0;
     bool started_ = false;

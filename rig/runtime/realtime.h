@@ -79,7 +79,7 @@ public:
         remotes_.set_watchdog(std::move(callback));
     }
     // As LockstepMaster::set_after_hello.
-    void set_after_hello(std::function<void(const std::vector<std::string>&)> callback) {
+    void set_after_hello(std::function<void(const std::vector<LockstepMaster::HelloTopics>&)> callback) {
         remotes_.set_after_hello(std::move(callback));
     }
 

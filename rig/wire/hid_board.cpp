@@ -190,14 +190,42 @@ void HidBoard::send(const io::DeviceSignals& signals, std::uint32_t spread_inter
     command.signals = signals;
     command.spread_interval_us = spread_interval_us;
     command.rebase_counters = rebase;
+    command.pwm_capture_inputs = pwm_capture_inputs_;
     const hid::Report report = hid::encode_command(command);  // throws before anything is sent
     transport_->write_report(report);
     last_sent_ = signals;
     ++next_sequence_;
 }
 
+void HidBoard::enable_pwm_capture(std::uint8_t inputs, PwmCaptureParams params) {
+    if ((inputs & ~hid::kPwmCaptureInputMask) != 0) {
+        throw std::invalid_argument("HID board: PWM capture inputs mask " + std::to_string(inputs) +
+                                    " names an input above " + std::to_string(hid::kPwmCaptureInputs - 1));
+    }
+    pwm_capture_inputs_ = inputs;
+    if (inputs == 0) {
+        pwm_capture_.reset();
+    } else {
+        pwm_capture_.emplace(params);
+    }
+}
+
 io::ActuatorCommands HidBoard::read_actuators() {
-    const auto consume = [this](const std::vector<std::uint8_t>& bytes) {
+    // A board with capture on interleaves edge reports with the status reports.
+    bool status_seen = false;
+    const auto consume = [this, &status_seen](const std::vector<std::uint8_t>& bytes) {
+        if (!bytes.empty() && bytes[0] == hid::kEdgeReportId) {
+            const auto edges = hid::decode_edges(bytes);
+            if (!edges.ok()) {
+                throw HidError(transport_->description() + ": malformed edge report: " + edges.error.reason);
+            }
+            if (!pwm_capture_) {
+                throw HidError(transport_->description() + ": an edge report though PWM capture is off");
+            }
+            pwm_capture_->on_report(*edges.value);
+            return;
+        }
+        status_seen = true;
         const auto decoded = hid::decode_status(bytes);
         if (!decoded.ok()) {
             throw HidError(transport_->description() + ": malformed status report: " + decoded.error.reason);
@@ -208,18 +236,34 @@ io::ActuatorCommands HidBoard::read_actuators() {
             status_reports_lost_ += gap;
         }
         last_status_ = status;
+        if (status.last_command_problem == hid::ReportProblem::unsupported_version && pwm_capture_inputs_ != 0 &&
+            status.protocol_version < hid::kPwmCaptureVersion) {
+            throw HidError(transport_->description() + ": the board speaks protocol version " +
+                           std::to_string(status.protocol_version) + " and refused PWM capture (version " +
+                           std::to_string(hid::kPwmCaptureVersion) + "); update its firmware");
+        }
         if (status.last_command_problem != hid::ReportProblem::none) {
             throw HidError(transport_->description() + ": the board refused the last command report (" +
                            hid::to_string(status.last_command_problem) + "); last command applied: #" +
                            std::to_string(status.last_command_sequence));
         }
     };
-    const auto first = transport_->read_report(status_timeout_);
-    if (!first) {
-        throw HidError(transport_->description() + ": no status report within " +
-                       std::to_string(status_timeout_.count()) + " ms");
+    // Bounded: the firmware sends a status at least every 10 ms, and at most
+    // one report per 1 ms interrupt interval, so a status comes within a few
+    // dozen reports; a board sending only edge reports is an error, not a hang.
+    constexpr int kMaxReportsWithoutStatus = 256;
+    for (int read = 0; !status_seen; ++read) {
+        if (read == kMaxReportsWithoutStatus) {
+            throw HidError(transport_->description() + ": " + std::to_string(read) +
+                           " reports in a row without a status report");
+        }
+        const auto next = transport_->read_report(status_timeout_);
+        if (!next) {
+            throw HidError(transport_->description() + ": no status report within " +
+                           std::to_string(status_timeout_.count()) + " ms");
+        }
+        consume(*next);
     }
-    consume(*first);
     // Reports queued behind it are newer: the newest wins.
     while (const auto queued = transport_->read_report(std::chrono::milliseconds(0))) consume(*queued);
     return last_status_->actuators;

@@ -21,6 +21,7 @@
 
 #include "rig/runtime/clock.h"
 #include "rig/wire/hid_board_protocol.h"
+#include "rig/wire/pwm_capture.h"
 #include "rig/runtime/io_image.h"
 
 struct hid_device_;  // hidapi's device handle (hidapi.h stays out of this header)
@@ -116,11 +117,22 @@ public:
     void rebase(const io::DeviceSignals& signals);
 
     // Reads the board's status (waiting up to status_timeout for the first
-    // report, then taking every report already queued) and returns the relay
+    // report, then taking every report already queued; edge reports in between
+    // go to pwm_capture()) and returns the relay
     // and valve outputs sensed in the newest. Throws HidError naming the board
     // when no report comes in time, a report is malformed (with the decoder's
     // reason), or the board says it refused our last command.
     io::ActuatorCommands read_actuators();
+
+    // Protocol version 2: PWM edge capture on the inputs in `inputs` (bit i =
+    // input i, 0..5; 0 turns capture off), carried by every command from the
+    // next apply() or rebase() on. The edge reports read_actuators() meets
+    // from then on go to pwm_capture(). Throws std::invalid_argument for a bit
+    // above 5 or bad params. A version-1 board refuses such a command: the next
+    // read_actuators() throws HidError saying the board lacks PWM capture.
+    void enable_pwm_capture(std::uint8_t inputs, PwmCaptureParams params = {});
+    // nullptr until enable_pwm_capture() with inputs.
+    const PwmCapture* pwm_capture() const { return pwm_capture_ ? &*pwm_capture_ : nullptr; }
 
     // From the newest status read so far (nullopt / defaults before the first).
     const std::optional<hid::BoardStatus>& last_status() const { return last_status_; }
@@ -138,6 +150,8 @@ private:
     std::optional<io::DeviceSignals> last_sent_;
     std::optional<hid::BoardStatus> last_status_;
     std::uint64_t status_reports_lost_ = 0;
+    std::uint8_t pwm_capture_inputs_ = 0;
+    std::optional<PwmCapture> pwm_capture_;
 };
 
 }  // namespace rig

@@ -19,8 +19,27 @@ constexpr std::size_t kPumpFlowCode = 16;
 constexpr std::size_t kBoomHeightCode = 18;
 constexpr std::size_t kDigitalOutputs = 20;
 constexpr std::size_t kFlags = 21;
-constexpr std::size_t kFirstReserved = 22;
+constexpr std::size_t kPwmCaptureInputs = 22;  // version 2; reserved in version 1
+constexpr std::size_t kFirstReservedV1 = 22;
+constexpr std::size_t kFirstReservedV2 = 23;
 }  // namespace command_offset
+
+namespace edge_offset {
+constexpr std::size_t kVersion = 1;
+constexpr std::size_t kSequence = 2;
+constexpr std::size_t kReportTime = 4;
+constexpr std::size_t kLevels = 8;
+constexpr std::size_t kFlags = 9;
+constexpr std::size_t kCount = 10;
+constexpr std::size_t kReservedByte11 = 11;
+constexpr std::size_t kBaseTime = 12;
+constexpr std::size_t kFirstEdge = 16;
+constexpr std::size_t kEdgeSize = 3;
+}  // namespace edge_offset
+constexpr std::uint8_t kOverflowBit = 0x01;
+constexpr std::uint8_t kEdgeFlagsUsed = kOverflowBit;
+constexpr std::uint32_t kEdgeInputShift = 20;
+constexpr std::uint32_t kEdgeRisingBit = 1u << 23;
 
 namespace status_offset {
 constexpr std::size_t kVersion = 1;
@@ -101,10 +120,12 @@ std::optional<ReportError> check_frame(std::span<const std::uint8_t> bytes, std:
         return ReportError{ReportProblem::wrong_report_id, "report id " + hex_byte(bytes[0]) + ", expected " +
                                                                hex_byte(expected_id) + " (" + report_name + ")"};
     }
-    if (bytes[1] != kProtocolVersion) {
+    const std::uint8_t oldest = expected_id == kEdgeReportId ? kPwmCaptureVersion : kOldestProtocolVersion;
+    if (bytes[1] < oldest || bytes[1] > kProtocolVersion) {
         return ReportError{ReportProblem::unsupported_version,
                            std::string(report_name) + " report has protocol version " + std::to_string(bytes[1]) +
-                               ", this rig speaks version " + std::to_string(kProtocolVersion)};
+                               ", this rig speaks versions " + std::to_string(oldest) + ".." +
+                               std::to_string(kProtocolVersion)};
     }
     return std::nullopt;
 }
@@ -172,7 +193,13 @@ Report encode_command(const BoardCommand& command) {
     }
     Report report{};
     report[0] = kCommandReportId;
-    report[command_offset::kVersion] = kProtocolVersion;
+    if ((command.pwm_capture_inputs & ~kPwmCaptureInputMask) != 0) {
+        throw std::invalid_argument("HID command: pwm_capture_inputs " + hex_byte(command.pwm_capture_inputs) +
+                                    " names an input above " + std::to_string(kPwmCaptureInputs - 1));
+    }
+    // Version 1 unless capture is asked for: a version-1 board gets exactly what it always did.
+    report[command_offset::kVersion] = command.pwm_capture_inputs != 0 ? kPwmCaptureVersion : kOldestProtocolVersion;
+    report[command_offset::kPwmCaptureInputs] = command.pwm_capture_inputs;
     put_u16(report, command_offset::kSequence, command.sequence);
     put_u32(report, command_offset::kWheelTarget, signals.wheel_encoder_count);
     put_u32(report, command_offset::kFlowTarget, signals.main_flow_pulses);
@@ -193,7 +220,11 @@ Report encode_status(const BoardStatus& status) {
     }
     Report report{};
     report[0] = kStatusReportId;
-    report[status_offset::kVersion] = kProtocolVersion;
+    if (status.protocol_version < kOldestProtocolVersion || status.protocol_version > kProtocolVersion) {
+        throw std::invalid_argument("HID status: protocol_version " + std::to_string(status.protocol_version) +
+                                    " is not 1.." + std::to_string(kProtocolVersion));
+    }
+    report[status_offset::kVersion] = status.protocol_version;
     put_u16(report, status_offset::kSequence, status.sequence);
     put_u16(report, status_offset::kCommandSequence, status.last_command_sequence);
     report[status_offset::kRelayInputs] = bits({{status.actuators.ball_valve_forward, kForwardBit},
@@ -220,9 +251,19 @@ Decoded<BoardCommand> decode_command(std::span<const std::uint8_t> bytes) {
                        check_analog_code(bytes, command_offset::kBoomHeightCode, "boom-height sensor code"),
                        check_reserved_bits(bytes, command_offset::kDigitalOutputs, kDigitalOutputsUsed,
                                            "digital outputs"),
-                       check_reserved_bits(bytes, command_offset::kFlags, kCommandFlagsUsed, "command flags"),
-                       check_reserved_bytes(bytes, command_offset::kFirstReserved, kReportSize)}) {
+                       check_reserved_bits(bytes, command_offset::kFlags, kCommandFlagsUsed, "command flags")}) {
         if (error) return refused<BoardCommand>(*error);
+    }
+    const bool v2 = bytes[command_offset::kVersion] >= kPwmCaptureVersion;
+    if (v2) {
+        if (auto error = check_reserved_bits(bytes, command_offset::kPwmCaptureInputs, kPwmCaptureInputMask,
+                                             "PWM capture inputs")) {
+            return refused<BoardCommand>(*error);
+        }
+    }
+    if (auto error = check_reserved_bytes(
+            bytes, v2 ? command_offset::kFirstReservedV2 : command_offset::kFirstReservedV1, kReportSize)) {
+        return refused<BoardCommand>(*error);
     }
     BoardCommand command;
     command.sequence = get_u16(bytes, command_offset::kSequence);
@@ -235,6 +276,8 @@ Decoded<BoardCommand> decode_command(std::span<const std::uint8_t> bytes) {
     command.signals.breakpoint_button = bit(outputs, kButtonBit);
     command.signals.spray_switch = bit(outputs, kSpraySwitchBit);
     command.rebase_counters = bit(bytes[command_offset::kFlags], kRebaseBit);
+    command.protocol_version = bytes[command_offset::kVersion];
+    command.pwm_capture_inputs = v2 ? bytes[command_offset::kPwmCaptureInputs] : 0;
     return Decoded<BoardCommand>{command, {}};
 }
 
@@ -275,7 +318,115 @@ Decoded<BoardStatus> decode_status(std::span<const std::uint8_t> bytes) {
     status.last_command_problem = static_cast<ReportProblem>(problem);
     status.indicators.breakpoints_stored = get_u16(bytes, status_offset::kBreakpointsStored);
     status.indicators.breakpoints_reached = get_u16(bytes, status_offset::kBreakpointsReached);
+    status.protocol_version = bytes[status_offset::kVersion];
     return Decoded<BoardStatus>{status, {}};
+}
+
+Report encode_edges(const EdgeReport& edges) {
+    if (edges.edges.size() > kMaxEdgesPerReport) {
+        throw std::invalid_argument("HID edges: " + std::to_string(edges.edges.size()) + " edges, a report holds " +
+                                    std::to_string(kMaxEdgesPerReport));
+    }
+    if ((edges.levels & ~kPwmCaptureInputMask) != 0) {
+        throw std::invalid_argument("HID edges: levels " + hex_byte(edges.levels) + " name an input above " +
+                                    std::to_string(kPwmCaptureInputs - 1));
+    }
+    Report report{};
+    report[0] = kEdgeReportId;
+    report[edge_offset::kVersion] = kPwmCaptureVersion;
+    put_u16(report, edge_offset::kSequence, edges.sequence);
+    put_u32(report, edge_offset::kReportTime, edges.report_time_us);
+    report[edge_offset::kLevels] = edges.levels;
+    report[edge_offset::kFlags] = bits({{edges.overflow, kOverflowBit}});
+    report[edge_offset::kCount] = static_cast<std::uint8_t>(edges.edges.size());
+    const std::uint32_t base = edges.edges.empty() ? 0 : edges.edges.front().time_us;
+    put_u32(report, edge_offset::kBaseTime, base);
+    std::uint32_t previous_offset = 0;
+    for (std::size_t i = 0; i < edges.edges.size(); ++i) {
+        const CapturedEdge& edge = edges.edges[i];
+        const std::string which = "HID edges: edge " + std::to_string(i);
+        if (edge.input >= kPwmCaptureInputs) {
+            throw std::invalid_argument(which + ": input " + std::to_string(edge.input) + " is not 0.." +
+                                        std::to_string(kPwmCaptureInputs - 1));
+        }
+        const std::int64_t offset = counter_ahead(base, edge.time_us);
+        if (offset < previous_offset || offset > kMaxEdgeOffsetUs) {
+            throw std::invalid_argument(which + ": " + std::to_string(offset) + " us after edge 0 (edges in time order, within " +
+                                        std::to_string(kMaxEdgeOffsetUs) + " us)");
+        }
+        if (counter_ahead(edge.time_us, edges.report_time_us) < 0) {
+            throw std::invalid_argument(which + ": after the report time");
+        }
+        previous_offset = static_cast<std::uint32_t>(offset);
+        const std::uint32_t packed = static_cast<std::uint32_t>(offset) |
+                                     (static_cast<std::uint32_t>(edge.input) << kEdgeInputShift) |
+                                     (edge.rising ? kEdgeRisingBit : 0u);
+        const std::size_t at = edge_offset::kFirstEdge + i * edge_offset::kEdgeSize;
+        for (std::size_t b = 0; b < edge_offset::kEdgeSize; ++b) report[at + b] = static_cast<std::uint8_t>(packed >> (8 * b));
+    }
+    return report;
+}
+
+Decoded<EdgeReport> decode_edges(std::span<const std::uint8_t> bytes) {
+    if (auto error = check_frame(bytes, kEdgeReportId, "edge")) return refused<EdgeReport>(*error);
+    const std::size_t count = bytes[edge_offset::kCount];
+    if (count > kMaxEdgesPerReport) {
+        return refused<EdgeReport>({ReportProblem::value_out_of_range,
+                                    "byte 10 (edge count): " + std::to_string(count) + " edges, a report holds " +
+                                        std::to_string(kMaxEdgesPerReport)});
+    }
+    for (auto error : {check_reserved_bits(bytes, edge_offset::kLevels, kPwmCaptureInputMask, "capture input levels"),
+                       check_reserved_bits(bytes, edge_offset::kFlags, kEdgeFlagsUsed, "edge flags"),
+                       check_reserved_bytes(bytes, edge_offset::kReservedByte11, edge_offset::kReservedByte11 + 1),
+                       check_reserved_bytes(bytes, edge_offset::kFirstEdge + count * edge_offset::kEdgeSize,
+                                            kReportSize)}) {
+        if (error) return refused<EdgeReport>(*error);
+    }
+    EdgeReport report;
+    report.sequence = get_u16(bytes, edge_offset::kSequence);
+    report.report_time_us = get_u32(bytes, edge_offset::kReportTime);
+    report.levels = bytes[edge_offset::kLevels];
+    report.overflow = bit(bytes[edge_offset::kFlags], kOverflowBit);
+    const std::uint32_t base = get_u32(bytes, edge_offset::kBaseTime);
+    if (count == 0 && base != 0) {
+        return refused<EdgeReport>({ReportProblem::reserved_bits_set, "bytes 12-15 (base time): " +
+                                                                          std::to_string(base) +
+                                                                          " with no edges, must be 0"});
+    }
+    std::uint32_t previous_offset = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t at = edge_offset::kFirstEdge + i * edge_offset::kEdgeSize;
+        std::uint32_t packed = 0;
+        for (std::size_t b = 0; b < edge_offset::kEdgeSize; ++b) packed |= static_cast<std::uint32_t>(bytes[at + b]) << (8 * b);
+        const std::uint32_t offset = packed & kMaxEdgeOffsetUs;
+        const auto input = static_cast<std::uint8_t>((packed >> kEdgeInputShift) & 0x7u);
+        const std::string where = "bytes " + std::to_string(at) + "-" + std::to_string(at + 2) + " (edge " +
+                                  std::to_string(i) + "): ";
+        if (input >= kPwmCaptureInputs) {
+            return refused<EdgeReport>({ReportProblem::value_out_of_range,
+                                        where + "input " + std::to_string(input) + " is not 0.." +
+                                            std::to_string(kPwmCaptureInputs - 1)});
+        }
+        if (i == 0 && offset != 0) {
+            return refused<EdgeReport>({ReportProblem::value_out_of_range,
+                                        where + "the first edge is the base, its offset " + std::to_string(offset) +
+                                            " must be 0"});
+        }
+        if (offset < previous_offset) {
+            return refused<EdgeReport>({ReportProblem::value_out_of_range,
+                                        where + "offset " + std::to_string(offset) + " us before the previous edge's " +
+                                            std::to_string(previous_offset)});
+        }
+        previous_offset = offset;
+        const std::uint32_t time = base + offset;  // wraps with the board's clock
+        if (counter_ahead(time, report.report_time_us) < 0) {
+            return refused<EdgeReport>({ReportProblem::value_out_of_range,
+                                        where + "at board time " + std::to_string(time) + " us, after the report time " +
+                                            std::to_string(report.report_time_us)});
+        }
+        report.edges.push_back(CapturedEdge{time, input, (packed & kEdgeRisingBit) != 0});
+    }
+    return Decoded<EdgeReport>{std::move(report), {}};
 }
 
 }  // namespace rig::hid

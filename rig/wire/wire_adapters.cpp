@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <stdexcept>
 
 #include "idl/topics.h"
 
@@ -153,6 +154,43 @@ TimeNs BoardIoAdapter::step(TimeNs now_ns) {
     }
     publish_outputs(now_ns);
     return next_update_ns_;
+}
+
+// ------------------------------------------------------------------ seed 001: PWM capture
+
+NozzlePwmCaptureAdapter::NozzlePwmCaptureAdapter(HidBoard& board, int nozzles, double poll_rate_hz,
+                                                 PwmCaptureParams params)
+    : board_(board), nozzles_(nozzles), period_ns_(0), params_(params) {
+    if (nozzles < 1 || nozzles > hid::kPwmCaptureInputs) {
+        throw std::invalid_argument("nozzle PWM capture: " + std::to_string(nozzles) + " nozzles, the board captures 1.." +
+                                    std::to_string(hid::kPwmCaptureInputs));
+    }
+    if (!(poll_rate_hz > 0.0 && poll_rate_hz <= 1000.0)) {
+        throw std::invalid_argument("nozzle PWM capture: poll rate " + std::to_string(poll_rate_hz) +
+                                    " Hz outside (0, 1000]");
+    }
+    period_ns_ = seconds_to_ns(1.0 / poll_rate_hz);
+}
+
+void NozzlePwmCaptureAdapter::configure(DdsContext& dds) {
+    writer_ = std::make_unique<Writer<msg::NozzlePwm>>(dds, topics::kNozzlePwm);
+}
+
+TimeNs NozzlePwmCaptureAdapter::step(TimeNs now_ns) {
+    if (!started_) {
+        board_.enable_pwm_capture(static_cast<std::uint8_t>((1u << nozzles_) - 1u), params_);
+        board_.rebase(io::DeviceSignals{});
+        started_ = true;
+    }
+    board_.read_actuators();  // takes the edge reports too
+    const msg::NozzlePwm pwm = board_.pwm_capture()->nozzle_pwm(nozzles_);
+    if (!last_published_ || pwm.duty_pct() != last_published_->duty_pct() ||
+        pwm.frequency_hz() != last_published_->frequency_hz()) {
+        writer_->publish(pwm);
+        last_published_ = pwm;
+        ++published_;
+    }
+    return next_period_boundary(now_ns, period_ns_);
 }
 
 }  // namespace rig

@@ -11,6 +11,8 @@
 //                       controller/breakpoint_event <- the board's indicator counters
 //     through a BoardIoWire: the Modbus slave (TCP or RTU, docs/modbus-register-map.md)
 //     or the USB-HID I/O board (docs/hid-io-board.md).
+//   NozzlePwmCaptureAdapter  the HID board's PWM capture (protocol version 2)
+//                       ->  actuator/nozzle_pwm/duty (seed 001's nozzle valves)
 //
 // Adapters run in real time only: a wire has no virtual time.
 #include <atomic>
@@ -25,6 +27,7 @@
 #include "rig/runtime/board_input_topics.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/wire/hid_board.h"
+#include "rig/wire/pwm_capture.h"
 #include "rig/runtime/io_image.h"
 #include "rig/wire/modbus_slave.h"
 #include "rig/runtime/node.h"
@@ -140,6 +143,37 @@ private:
     // --- publications
     std::unique_ptr<ActuatorTopicsWriter> actuators_writer_;  // the three actuator topics
     std::unique_ptr<Writer<msg::BreakpointEvent>> event_writer_;
+};
+
+// Seed 001 on the bench: the controller's six GPIO PWM outputs, captured by
+// the HID I/O board (protocol version 2, docs/hid-io-board.md "PWM edge
+// capture"), become the actuator state a DDS controller publishes, so the
+// plant takes them unchanged. The first step enables capture on the first
+// `nozzles` inputs (a re-basing command: this board drives no pulse outputs
+// here); each step then reads the board's reports and publishes when the
+// decoded duties or frequency change.
+//   Publications: actuator/nozzle_pwm/duty (msg::NozzlePwm)
+class NozzlePwmCaptureAdapter final : public Node {
+public:
+    // Throws std::invalid_argument for nozzles outside 1..6 or a poll rate
+    // outside (0, 1000] Hz. The board must outlive the adapter.
+    NozzlePwmCaptureAdapter(HidBoard& board, int nozzles, double poll_rate_hz, PwmCaptureParams params = {});
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override { return false; }  // polled
+    std::uint64_t published() const { return published_; }
+
+private:
+    std::string name_ = "nozzle_pwm_capture";
+    HidBoard& board_;
+    int nozzles_;
+    TimeNs period_ns_;
+    PwmCaptureParams params_;
+    bool started_ = false;
+    std::optional<msg::NozzlePwm> last_published_;
+    std::uint64_t published_ = 0;
+    std::unique_ptr<Writer<msg::NozzlePwm>> writer_;
 };
 
 }  // namespace rig
