@@ -34,7 +34,7 @@ public:
         if (active_) use_dds_security_identity(credentials->identity_dir(kRigIdentity));
     }
     ~RigIdentityScope() {
-        if (active_) use_dds_security_identity(std::nullopt);
+        if (active_) use_dds_security_identity(std::filesystem::path());
     }
     RigIdentityScope(const RigIdentityScope&) = delete;
     RigIdentityScope& operator=(const RigIdentityScope&) = delete;

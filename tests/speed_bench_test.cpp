@@ -45,6 +45,27 @@ TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
     EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"), bench.at("in_process").at("trace_bytes_per_sim_minute"));
 }
 
+TEST(SpeedBench, WithDdsSecurityAddsTheSecuredFloorAndProcessModeWithTheSameDigest) {
+    const std::filesystem::path dir = fresh_dir("speed_bench_dds_security");
+    const std::string output = read_all_command(
+        std::string(RIG_BINARY_DIR) + "/bin/rig bench " + RIG_SOURCE_DIR +
+        "/cases/table5-6-continuation/continuation-6kmh.yaml --repeat 1 --pingpong-rounds 50 --dds-security --out " +
+        dir.string() + " 2>&1; echo \"exit=$?\"");
+    EXPECT_NE(output.find("exit=0"), std::string::npos) << output;
+    EXPECT_NE(output.find("DDS ping-pong, DDS-Security"), std::string::npos) << output;
+    EXPECT_NE(output.find("process mode, DDS-Security"), std::string::npos) << output;
+    EXPECT_NE(output.find("us per round in process mode"), std::string::npos) << output;
+    EXPECT_NE(output.find("trace digests identical in every run of every mode"), std::string::npos) << output;
+    ASSERT_TRUE(std::filesystem::exists(dir / "bench.json")) << output;
+    const nlohmann::json bench = nlohmann::json::parse(read_all(dir / "bench.json"));
+    EXPECT_TRUE(bench.at("digests_identical").get<bool>());
+    EXPECT_EQ(bench.at("pingpong_dds_security").at("rounds").get<int>(), 50);
+    EXPECT_GT(bench.at("pingpong_dds_security").at("p50_us").get<double>(), 0.0);
+    EXPECT_EQ(bench.at("process_dds_security").at("rounds"), bench.at("process").at("rounds"));
+    EXPECT_GT(bench.at("process_dds_security").at("us_per_round").get<double>(), 0.0);
+    EXPECT_TRUE(std::filesystem::exists(dir / "security" / "controller" / "cert.pem"));
+}
+
 TEST(SpeedBench, ARealTimeCaseIsRefusedNamingWhy) {
     const std::filesystem::path dir = fresh_dir("speed_bench_realtime");
     const std::string output = read_all_command(std::string(RIG_BINARY_DIR) + "/bin/rig bench " + RIG_SOURCE_DIR +
