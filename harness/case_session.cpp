@@ -44,6 +44,22 @@ modbus::CommsFailsafe comms_failsafe(const BoardSpec& board) {
     return {std::chrono::milliseconds(std::lround(board.failsafe_timeout_s * 1000.0)), board.failsafe};
 }
 
+// A serial line the rig writes: `port` is "pty" (a pseudo-terminal made here)
+// or a device path. Sets `writer` to the rig's end; returns the far end's path.
+std::string open_serial_line(const std::string& port, int baud, std::unique_ptr<PtyPair>& pty,
+                             std::unique_ptr<SerialPort>& device, SerialPort*& writer) {
+    SerialSettings line;
+    line.baud = baud;
+    if (port == "pty") {
+        pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
+        writer = &pty->master();
+        return pty->slave_path();
+    }
+    device = std::make_unique<SerialPort>(port, line);
+    writer = device.get();
+    return port;
+}
+
 }  // namespace
 
 BenchWires open_bench_wires(const CaseSpec& spec) {
@@ -51,24 +67,23 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
     const WiringSpec& wiring = spec.wiring;
     std::vector<std::string> parts;
     if (wiring.gnss == GnssWire::serial) {
-        SerialSettings line;
-        line.baud = wiring.nmea_baud;
-        std::string far_end;
-        if (wiring.gnss_port == "pty") {
-            wires.gnss_pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
-            wires.gnss_port = &wires.gnss_pty->master();
-            far_end = wires.gnss_pty->slave_path();
-        } else {
-            wires.gnss_device = std::make_unique<SerialPort>(wiring.gnss_port, line);
-            wires.gnss_port = wires.gnss_device.get();
-            far_end = wiring.gnss_port;
-        }
+        const std::string far_end =
+            open_serial_line(wiring.gnss_port, wiring.nmea_baud, wires.gnss_pty, wires.gnss_device, wires.gnss_port);
         wires.gnss_far_end = far_end;
         wires.controller_args.insert(wires.controller_args.end(),
                                      {"--nmea-serial", far_end, "--nmea-baud", std::to_string(wiring.nmea_baud)});
         parts.push_back("gnss serial " + far_end + " " + std::to_string(wiring.nmea_baud) + " baud");
     } else {
         parts.push_back("gnss dds");
+    }
+    if (wiring.laser == GnssWire::serial) {
+        wires.laser_far_end = open_serial_line(wiring.laser_port, wiring.laser_baud, wires.laser_pty,
+                                               wires.laser_device, wires.laser_port);
+        wires.controller_args.insert(wires.controller_args.end(), {"--laser-serial", wires.laser_far_end,
+                                                                   "--laser-baud", std::to_string(wiring.laser_baud)});
+        parts.push_back("laser serial " + wires.laser_far_end + " " + std::to_string(wiring.laser_baud) + " baud");
+    } else if (spec.system == CaseSystem::boundary) {
+        parts.push_back("laser dds");
     }
     switch (wiring.board_io) {
         case BoardIoWireKind::dds: parts.push_back("board_io dds"); break;

@@ -32,6 +32,11 @@ struct BenchWires {
     std::unique_ptr<SerialPort> gnss_device;
     SerialPort* gnss_port = nullptr;  // the rig writes NMEA here
     std::string gnss_far_end;         // what the controller opens
+    // Seed 001's L4 laser line (`laser: serial`), like the GNSS's.
+    std::unique_ptr<PtyPair> laser_pty;
+    std::unique_ptr<SerialPort> laser_device;
+    SerialPort* laser_port = nullptr;  // the rig writes the laser's lines here
+    std::string laser_far_end;
     std::unique_ptr<PtyLink> modbus_link;
     std::unique_ptr<BoardIoWire> board_io;
     std::string board_io_far_end;     // what the controller opens: a tty path or ADDRESS:PORT
