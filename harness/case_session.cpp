@@ -148,8 +148,11 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
                                    const std::filesystem::path& case_dir) {
     // The controller under test, in its own process on this run's own domain
     // (none when a real board is wired up: `wiring: { controller: external }`).
-    if (spec.wiring.external_controller || controller_ || in_process_) return;
+    if (controller_ || in_process_) return;
+    // An external board is given the same file beside attach.json: a seed-001
+    // Pi takes its areas and mounting from it.
     write_controller_config(spec, case_dir / "controller.yaml");
+    if (spec.wiring.external_controller) return;
     std::vector<std::string> argv = spec.controller.command;
     if (argv.empty()) {
         argv.push_back(controller_executable.string());
