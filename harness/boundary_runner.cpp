@@ -93,7 +93,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         std::filesystem::create_directories(case_dir / "controller-state");
         const BoundaryCaseSpec& boundary = *spec.boundary;
         const BoundaryWorld world(boundary, seed);
-        CaseSession session(spec, case_dir, options.domain);
+        CaseSession session(spec, case_dir, options.domain, options.open_hid);
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
         session.start_controller(spec, options.controller_executable.parent_path() / kBoundaryControllerExecutable, case_dir);
         TraceRecorder trace(dds, trace_file);

@@ -468,7 +468,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 
         const CaseWorld world = build_case_world(spec, seed);
         emulators::SprayCircuit circuit(world.plant, world.circuit);
-        CaseSession session(spec, case_dir, options.domain);
+        CaseSession session(spec, case_dir, options.domain, options.open_hid);
         // The harness's participant first, watching discovery; then the
         // controller, so every endpoint it makes is seen.
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);

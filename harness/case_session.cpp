@@ -62,7 +62,7 @@ std::string open_serial_line(const std::string& port, int baud, std::unique_ptr<
 
 }  // namespace
 
-BenchWires open_bench_wires(const CaseSpec& spec) {
+BenchWires open_bench_wires(const CaseSpec& spec, const HidTransportOpener& open_hid) {
     BenchWires wires;
     const WiringSpec& wiring = spec.wiring;
     std::vector<std::string> parts;
@@ -122,7 +122,8 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
         }
         case BoardIoWireKind::hid: {
             // A real bench board; the controller is wired to it, not to the rig process.
-            auto transport = HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
+            std::unique_ptr<HidTransport> transport = open_hid ? open_hid(wiring.hid_vid, wiring.hid_pid)
+                                                               : HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
             const std::string description = transport->description();
             wires.board_io_far_end = description;
             wires.board_io = std::make_unique<HidBoardWire>(std::make_unique<HidBoard>(std::move(transport)), description);
@@ -138,8 +139,8 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
 
 
 CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
-                         std::optional<std::uint32_t> domain)
-    : wires_(open_bench_wires(spec)),
+                         std::optional<std::uint32_t> domain, const HidTransportOpener& open_hid)
+    : wires_(open_bench_wires(spec, open_hid)),
       lease_(domain ? DomainLease::acquire_exact(*domain) : spec.domain ? DomainLease::acquire_exact(*spec.domain)
                                                                          : DomainLease::acquire()),
       controller_log_(case_dir / "controller.log") {}

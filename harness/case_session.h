@@ -46,14 +46,15 @@ struct BenchWires {
     std::shared_ptr<emulators::RtuLineNoise> line_noise;
 };
 // Opens what spec.wiring asks for; throws std::runtime_error naming the port.
-BenchWires open_bench_wires(const CaseSpec& spec);
+// `open_hid`: how a HID board is opened (empty: hidapi, rig/wire/hid_board.h).
+BenchWires open_bench_wires(const CaseSpec& spec, const HidTransportOpener& open_hid = {});
 
 class CaseSession {
 public:
     // Opens the wires and takes a DDS domain. Throws std::runtime_error naming
     // what could not be opened.
     CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
-                std::optional<std::uint32_t> domain = std::nullopt);
+                std::optional<std::uint32_t> domain = std::nullopt, const HidTransportOpener& open_hid = {});
     // Writes the controller's configuration into case_dir and starts the
     // controller with the wires' far ends (unless the case wires an external
     // board). Called once the harness's participant exists on the domain, so
