@@ -238,23 +238,35 @@ std::string CaseSession::controller_log_tail(std::size_t max_lines) const {
     return controller_ || in_process_ ? log_tail(controller_log_, max_lines) : std::string();
 }
 
-std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {
-    if (!wires_.gnss_pty) return {};
-    const std::size_t unread = wires_.gnss_pty->unread_bytes();
+std::string CaseSession::unread_problem(PtyPair* pty, const std::string& line, const std::string& far_end,
+                                        const std::string& what, UnreadWatch& watch,
+                                        std::chrono::milliseconds unread_for) {
+    if (pty == nullptr) return {};
+    const std::size_t unread = pty->unread_bytes();
     // Bytes waiting is normal between reads; bytes waiting that never go down
     // mean nobody has the line open, or nobody reads it.
-    if (unread == 0 || unread < gnss_unread_) {
-        gnss_unread_since_.reset();
-    } else if (!gnss_unread_since_) {
-        gnss_unread_since_.emplace();
+    if (unread == 0 || unread < watch.unread) {
+        watch.since.reset();
+    } else if (!watch.since) {
+        watch.since.emplace();
     }
-    gnss_unread_ = unread;
-    if (gnss_unread_since_ && gnss_unread_since_->elapsed() > unread_for) {
-        return "nobody reads the GNSS line " + wires_.gnss_far_end + ": " + std::to_string(unread) +
-               " bytes of NMEA written to it have waited unread for more than " +
-               std::to_string(unread_for.count()) + " ms (is the board attached to that port?)";
+    watch.unread = unread;
+    if (watch.since && watch.since->elapsed() > unread_for) {
+        return "nobody reads the " + line + " line " + far_end + ": " + std::to_string(unread) + " bytes of " + what +
+               " written to it have waited unread for more than " + std::to_string(unread_for.count()) +
+               " ms (is the board attached to that port?)";
     }
     return {};
+}
+
+std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {
+    std::string problem =
+        unread_problem(wires_.gnss_pty.get(), "GNSS", wires_.gnss_far_end, "NMEA", gnss_watch_, unread_for);
+    if (problem.empty()) {
+        problem = unread_problem(wires_.laser_pty.get(), "laser", wires_.laser_far_end, "laser lines", laser_watch_,
+                                 unread_for);
+    }
+    return problem;
 }
 
 }  // namespace rig::harness

@@ -89,8 +89,9 @@ public:
     TraceOutcome run_to_outcome(const std::function<void()>& run, TimeNs end_ns, const TimeNs& now_ns);
     // The last lines of the controller's log, for error messages.
     std::string controller_log_tail(std::size_t max_lines = 6) const;
-    // A bench wire whose far end does not take what the rig writes: the GNSS pty
-    // holding bytes nobody read for longer than `unread_for`. Empty when fine.
+    // A bench wire whose far end does not take what the rig writes: the GNSS
+    // (or laser) pty holding bytes nobody read for longer than `unread_for`.
+    // Empty when fine.
     std::string wire_problem(std::chrono::milliseconds unread_for);
 
 private:
@@ -99,9 +100,15 @@ private:
     std::filesystem::path controller_log_;
     std::optional<ChildProcess> controller_;
     std::unique_ptr<InProcessController> in_process_;
-    // GNSS pty watch: the unread byte count, and since when it has not gone down.
-    std::size_t gnss_unread_ = 0;
-    std::optional<WallStopwatch> gnss_unread_since_;
+    // A pty's watch: the unread byte count, and since when it has not gone down.
+    struct UnreadWatch {
+        std::size_t unread = 0;
+        std::optional<WallStopwatch> since;
+    };
+    static std::string unread_problem(PtyPair* pty, const std::string& line, const std::string& far_end,
+                                      const std::string& what, UnreadWatch& watch, std::chrono::milliseconds unread_for);
+    UnreadWatch gnss_watch_;
+    UnreadWatch laser_watch_;
 };
 
 }  // namespace rig::harness

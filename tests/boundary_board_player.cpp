@@ -9,10 +9,15 @@
 // (BoundaryControllerNode in wired mode): what is under test here is the rig's
 // side of the wires. It ends when the rig closes the lines at the case's end.
 //   boundary_board_player --attach OUT/cases/NAME/attach.json [--wait-s 60]
+//                         [--leave-laser-unread 1]
+// --leave-laser-unread: a miswired Pi that opens the laser line but never
+// reads it (its height then comes from DDS): the rig must fail the case at
+// once, naming that line.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -36,6 +41,7 @@ std::string port_of(const nlohmann::json& attach, const std::string& role) {
 int main(int argc, char** argv) {
     std::filesystem::path attach_file;
     double wait_s = 60.0;
+    bool leave_laser_unread = false;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         if (i + 1 >= argc) {
@@ -45,6 +51,7 @@ int main(int argc, char** argv) {
         const std::string value = argv[++i];
         if (arg == "--attach") attach_file = value;
         else if (arg == "--wait-s") wait_s = std::stod(value);
+        else if (arg == "--leave-laser-unread") leave_laser_unread = value == "1";
         else {
             std::cerr << "boundary_board_player: unknown option " << arg << "\n";
             return 2;
@@ -69,6 +76,11 @@ int main(int argc, char** argv) {
         rig::controller::boundary::BoundarySerialLines lines;
         lines.nmea_port = port_of(attach, "gnss_nmea");
         lines.laser_port = port_of(attach, "laser_serial");
+        std::optional<rig::SerialPort> unread_laser;
+        if (leave_laser_unread) {
+            unread_laser.emplace(lines.laser_port);
+            lines.laser_port.clear();
+        }
         const auto domain = attach.at("dds_domain").get<std::uint32_t>();
         rig::DdsContext dds(domain, "pi_player");
         rig::controller::boundary::BoundaryControllerNode pi(

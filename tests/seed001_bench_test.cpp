@@ -15,7 +15,9 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "rig/host/child_process.h"
 #include "rig/runtime/clock.h"
@@ -40,13 +42,18 @@ struct BenchRun {
 
 // `rig run` on `case_file`, with the Pi player beside it when `with_board`;
 // waits for both, bounded far above what the run needs (15 s of case time).
-BenchRun run_bench(const fs::path& dir, const fs::path& case_file, bool with_board) {
+BenchRun run_bench(const fs::path& dir, const fs::path& case_file, bool with_board,
+                   const std::vector<std::string>& board_args = {}) {
     const fs::path out = dir / "out";
     const fs::path attach_file = out / "cases" / kCaseName / "attach.json";
     rig::ChildProcess rig_run({RIG_BINARY_DIR "/bin/rig", "run", case_file.string(), "--out", out.string()},
                               dir / "rig.log");
     std::optional<rig::ChildProcess> board;
-    if (with_board) board.emplace(std::vector<std::string>{RIG_BOUNDARY_PLAYER, "--attach", attach_file.string()}, dir / "board.log");
+    if (with_board) {
+        std::vector<std::string> argv = {RIG_BOUNDARY_PLAYER, "--attach", attach_file.string()};
+        argv.insert(argv.end(), board_args.begin(), board_args.end());
+        board.emplace(argv, dir / "board.log");
+    }
     const rig::RealtimeClock clock;
     BenchRun run;
     for (;;) {
@@ -113,17 +120,21 @@ TEST(Seed001BenchRealTime, ReferenceControllerOnSerialLinesPassesTheDriveOut) {
     EXPECT_EQ(log.find("rejected"), std::string::npos) << log;
 }
 
-TEST(Seed001BenchRealTime, AnExternalPiAttachedToTheLinesPassesTheDriveOut) {
-    const fs::path dir = fresh_dir("seed001-bench-external");
+// The shipped wired case with its controller outside the rig.
+fs::path external_case(const fs::path& dir) {
     std::string text = read_all(kCaseFile);
     const std::string wiring = "\nwiring:\n";
     const std::size_t at = text.find(wiring);
-    ASSERT_NE(at, std::string::npos);
+    if (at == std::string::npos) throw std::runtime_error("the wired case has no wiring section");
     text.insert(at + wiring.size(), "  controller: external\n");
     const fs::path case_file = dir / "drive-out-external.yaml";
     std::ofstream(case_file) << text;
+    return case_file;
+}
 
-    const BenchRun run = run_bench(dir, case_file, /*with_board=*/true);
+TEST(Seed001BenchRealTime, AnExternalPiAttachedToTheLinesPassesTheDriveOut) {
+    const fs::path dir = fresh_dir("seed001-bench-external");
+    const BenchRun run = run_bench(dir, external_case(dir), /*with_board=*/true);
     expect_judged_and_passed(run);
     EXPECT_EQ(run.result["controller_mode"], "external");
     // Where to attach: both lines, and the domain the Pi publishes its duties in.
@@ -135,4 +146,24 @@ TEST(Seed001BenchRealTime, AnExternalPiAttachedToTheLinesPassesTheDriveOut) {
     // The player ran to the end of the case and left when the rig closed the lines.
     EXPECT_NE(run.board_log.find("boundary_board_player: RMC on /dev/pts/"), std::string::npos) << run.board_log;
     EXPECT_NE(run.board_log.find("player process exited with status 0"), std::string::npos) << run.board_log;
+}
+
+// A Pi that opened the laser line but never reads it: the rig fails the case
+// as wire_unread naming that line, as it does seed 000's GNSS line, with
+// results written, instead of streaming into it until the case's wall bound.
+TEST(Seed001BenchRealTime, APiThatNeverReadsTheLaserLineFailsNamingIt) {
+    const fs::path dir = fresh_dir("seed001-bench-laser-unread");
+    const BenchRun run = run_bench(dir, external_case(dir), /*with_board=*/true, {"--leave-laser-unread", "1"});
+    ASSERT_TRUE(run.result.is_object()) << run.exit << "\n" << run.rig_log << run.board_log;
+    EXPECT_EQ(run.result["verdict"], "failed") << run.result.dump(2);
+    EXPECT_EQ(run.result["error_kind"], "wire_unread") << run.result.dump(2);
+    const std::string error = run.result["error"].is_string() ? run.result["error"].get<std::string>() : "";
+    const std::string laser = [&] {
+        for (const nlohmann::json& port : run.attach["ports"]) {
+            if (port["role"] == "laser_serial") return port["path"].get<std::string>();
+        }
+        return std::string("(no laser port in attach.json)");
+    }();
+    EXPECT_NE(error.find("nobody reads the laser line " + laser), std::string::npos) << error;
+    EXPECT_EQ(run.exit, "process exited with status 1") << run.rig_log;
 }
