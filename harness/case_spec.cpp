@@ -4,6 +4,7 @@
 #include "harness/boundary_case.h"
 #include "rig/config/file_access.h"
 #include "rig/runtime/failure_kind.h"
+#include "rig/wire/hid_board_protocol.h"
 #include "rig/wire/modbus_protocol.h"
 
 #include <algorithm>
@@ -703,6 +704,19 @@ CaseSpec read_boundary_system_case(const YamlSection& root, CaseSpec spec) {
     // controller process beside it would be a second writer of that topic.
     if (spec.wiring.board_io == BoardIoWireKind::hid && !spec.wiring.external_controller) {
         root.section("wiring").fail("board_io", "the HID board captures a wired controller's PWM: needs `controller: external`");
+    }
+    if (spec.wiring.board_io == BoardIoWireKind::hid) {
+        // rig/wire/wire_adapters.h NozzlePwmCaptureAdapter: six capture inputs, read at most at 1 kHz.
+        if (spec.wiring.board_update_hz > 1000.0) {
+            root.section("wiring").fail("board_update_hz", "the PWM capture is read at most 1000 times a second, got " +
+                                                               number_text(spec.wiring.board_update_hz));
+        }
+        const int nozzles = boundary->flow_table_or_paper().nozzle_count();
+        if (nozzles > hid::kPwmCaptureInputs) {
+            root.section("wiring").fail("board_io", "the HID board captures " + std::to_string(hid::kPwmCaptureInputs) +
+                                                        " PWM inputs; this sprayer has " + std::to_string(nozzles) +
+                                                        " nozzles");
+        }
     }
     check_boundary_case(*boundary, root);
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {

@@ -91,7 +91,7 @@ TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
 // The bench path's keys (docs/seed001-boundary.md "Bench path"): the shipped
 // wired case reads as written; each wire that cannot work is refused at its key.
 TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {
-    const CaseSpec wired = parse_case(shipped("seed001-bench-wired/drive-out-wired.yaml"), "drive-out-wired.yaml");
+    const CaseSpec wired = parse_case(shipped("bench-wired/seed001-drive-out-wired.yaml"), "drive-out-wired.yaml");
     EXPECT_EQ(wired.mode, RunMode::realtime);
     EXPECT_EQ(wired.wiring.gnss, GnssWire::serial);
     EXPECT_EQ(wired.wiring.laser, GnssWire::serial);
@@ -115,6 +115,10 @@ TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {
     EXPECT_NE(hid.find("controller: external"), std::string::npos) << hid;
     EXPECT_EQ(load_error(with("mode: realtime\nwiring: { gnss: serial, laser: serial, board_io: hid, controller: external }\n")),
               "(accepted)");
+    // The capture is read at most at 1 kHz.
+    const std::string rate =
+        load_error(with("mode: realtime\nwiring: { gnss: serial, board_io: hid, controller: external, board_update_hz: 1500 }\n"));
+    EXPECT_NE(rate.find("wiring.board_update_hz"), std::string::npos) << rate;
     // An external board needs a wire to attach to.
     EXPECT_NE(load_error(with("mode: realtime\nwiring: { controller: external }\n")).find("bench wire"), std::string::npos);
     // A misspelt value and a bad baud, at their keys.

@@ -159,7 +159,7 @@ void drive_capture_inputs(int duty_fd, WallClockBoard& board) {
 
 TEST(Seed001BenchHidRealTime, ThePisPwmCapturedByTheBoardPassesTheDriveOut) {
     const fs::path dir = rig::testing::fresh_dir("seed001-bench-hid");
-    std::string text = rig::testing::read_all(RIG_SOURCE_DIR "/cases/seed001-bench-wired/drive-out-wired.yaml");
+    std::string text = rig::testing::read_all(RIG_SOURCE_DIR "/cases/bench-wired/seed001-drive-out-wired.yaml");
     const std::string wiring = "\nwiring:\n";
     const std::size_t at = text.find(wiring);
     ASSERT_NE(at, std::string::npos);

@@ -30,7 +30,7 @@ using rig::testing::read_all;
 namespace {
 
 const std::string kCaseName = "seed001-bench-drive-out-wired";
-const fs::path kCaseFile = fs::path(RIG_SOURCE_DIR) / "cases" / "seed001-bench-wired" / "drive-out-wired.yaml";
+const fs::path kCaseFile = fs::path(RIG_SOURCE_DIR) / "cases" / "bench-wired" / "seed001-drive-out-wired.yaml";
 
 struct BenchRun {
     std::string exit;
