@@ -26,6 +26,7 @@
 #include "controller/boundary/boundary_node_config.h"
 #include "rig/runtime/clock.h"
 #include "rig/runtime/dds_context.h"
+#include "rig/runtime/realtime.h"
 
 namespace {
 
@@ -87,6 +88,8 @@ int main(int argc, char** argv) {
             "pi_player",
             rig::controller::boundary::load_boundary_node_config(attach_file.parent_path() / "controller.yaml"), lines);
         pi.configure(dds);
+        // A Pi's controller loop runs at real-time priority, as the reference controller asks.
+        std::cout << "boundary_board_player: " << rig::request_realtime_scheduling(40).detail << std::endl;
         std::cout << "boundary_board_player: RMC on " << lines.nmea_port << ", laser on " << lines.laser_port
                   << ", PWM on DDS domain " << domain << std::endl;
         for (;;) {

@@ -7,7 +7,8 @@
 // on the RMC and laser lines, and drives the fake board's six capture inputs
 // with its PWM. What reaches the plant is what the board captured
 // (NozzlePwmCaptureAdapter -> actuator/nozzle_pwm/duty), and the drive out is
-// judged on the lockstep case's limit with the rig's lateness valid. (The Pi
+// judged on the wired case's limit plus the capture's steady-level window,
+// with the rig's lateness valid. (The Pi
 // is a forked process: the rig sees a board attach by another process opening
 // the ptys.)
 #include <gtest/gtest.h>
@@ -32,6 +33,7 @@
 #include "harness/case_runner.h"
 #include "harness/case_spec.h"
 #include "rig/runtime/clock.h"
+#include "rig/runtime/realtime.h"
 #include "rig/wire/serial_port.h"
 #include "run_support.h"
 
@@ -105,6 +107,8 @@ int pi_main(const fs::path& attach_file, int duty_fd) {
         }
         clock.sleep_until_ns(clock.now_ns() + rig::seconds_to_ns(0.02));
     }
+    // A Pi's controller loop runs at real-time priority, as the reference controller asks.
+    std::cerr << "pi: " << rig::request_realtime_scheduling(40).detail << "\n";
     try {
         std::ifstream in(attach_file);
         const nlohmann::json attach = nlohmann::json::parse(in);
@@ -169,10 +173,10 @@ TEST(Seed001BenchHidRealTime, ThePisPwmCapturedByTheBoardPassesTheDriveOut) {
     // which the capture can call 0 % only once no edge followed for
     // steady_after_us (250 ms, rig/wire/pwm_capture.h). That is 0.375 m more
     // overrun at 1.5 m/s, measured, not the Pi's: the limit adds it.
-    const std::string limit = "drive_out_excess_mean_m: 0.50";
+    const std::string limit = "drive_out_excess_mean_m: 0.67";
     const std::size_t limit_at = text.find(limit);
     ASSERT_NE(limit_at, std::string::npos);
-    text.replace(limit_at, limit.size(), "drive_out_excess_mean_m: 0.875");
+    text.replace(limit_at, limit.size(), "drive_out_excess_mean_m: 1.045");
     const fs::path case_file = dir / "drive-out-hid.yaml";
     std::ofstream(case_file) << text;
     const rig::harness::CaseSpec spec = rig::harness::load_case_file(case_file);
@@ -192,6 +196,9 @@ TEST(Seed001BenchHidRealTime, ThePisPwmCapturedByTheBoardPassesTheDriveOut) {
     }
     ::close(duty_pipe[1]);
     std::thread capture_inputs([&] { drive_capture_inputs(duty_pipe[0], board); });
+    // The board's pins follow the Pi at once, however busy the machine: above
+    // the rig's wire threads' 45, as a separate board would be.
+    rig::raise_thread_to_realtime(capture_inputs, 46);
     const rig::harness::CaseRun run = rig::harness::run_case(spec, options);
     int pi_status = 0;
     // The Pi leaves when the rig closes the lines; one that did not is stopped.

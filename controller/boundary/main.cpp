@@ -38,11 +38,11 @@ int main(int argc, char** argv) {
     app.add_option("--laser-baud", serial.laser_line.baud, "wired mode: laser line baud rate");
     CLI11_PARSE(app, argc, argv);
     try {
+        const bool wired = !serial.nmea_port.empty() || !serial.laser_port.empty();
+        if (wired && clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
         // The context first: the node's readers and writers unregister from it
         // when the node is destroyed, so it must outlive the node.
         rig::DdsContext dds(domain_id, node_name);
-        const bool wired = !serial.nmea_port.empty() || !serial.laser_port.empty();
-        if (wired && clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
         rig::controller::boundary::BoundaryControllerNode controller(
             node_name, rig::controller::boundary::load_boundary_node_config(config_file), serial);
         rig::FollowerOptions options;
