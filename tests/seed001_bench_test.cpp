@@ -168,3 +168,29 @@ TEST(Seed001BenchRealTime, APiThatNeverReadsTheLaserLineFailsNamingIt) {
     EXPECT_NE(error.find("nobody reads the laser line " + laser), std::string::npos) << error;
     EXPECT_EQ(run.exit, "process exited with status 1") << run.rig_log;
 }
+
+// The rig's own lateness on a boundary case (docs/metrics.md "Verdicts"): the
+// wired case with the rig's loop stalled 0.5 s at t = 3 s (`rig_faults`, the
+// overload detection's self-test) is invalid (rig_overloaded), not a failure
+// of the controller, whatever the controller did; exit status 3.
+TEST(Seed001BenchRealTime, AStalledRigMakesTheBoundaryCaseInvalidNotFailed) {
+    const fs::path dir = fresh_dir("seed001-bench-stall");
+    std::string text = read_all(kCaseFile);
+    const std::string bound = "\nrealtime: ";
+    const std::size_t at = text.find(bound);
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at + 1, "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 0.5 }\n");
+    const fs::path case_file = dir / "drive-out-stalled.yaml";
+    std::ofstream(case_file) << text;
+
+    const BenchRun run = run_bench(dir, case_file, /*with_board=*/false);
+    ASSERT_TRUE(run.result.is_object()) << run.exit << "\n" << run.rig_log;
+    EXPECT_EQ(run.result["verdict"], "invalid") << run.result.dump(2);
+    EXPECT_EQ(run.result["error_kind"], "rig_overloaded") << run.result.dump(2);
+    const nlohmann::json& lateness = run.result["realtime"]["rig_lateness"];
+    EXPECT_GE(lateness["max_ms"].get<double>(), 490.0) << lateness.dump(2);
+    EXPECT_GE(lateness["worst_at_s"].get<double>(), 3.0) << lateness.dump(2);
+    // Its metrics are still reported, for what they are worth.
+    EXPECT_TRUE(run.result["metrics"].contains("drive_out_excess_mean_m")) << run.result.dump(2);
+    EXPECT_EQ(run.exit, "process exited with status 3") << run.rig_log;
+}
