@@ -42,6 +42,10 @@ std::vector<AttachPort> attach_ports(const CaseSpec& spec, const BenchWires& wir
         ports.push_back(AttachPort{"gnss_nmea", wires.gnss_far_end, line_settings(wiring.nmea_baud),
                                    wires.gnss_pty ? kPtyOpened : kNotObservable});
     }
+    if (wiring.laser == GnssWire::serial) {
+        ports.push_back(AttachPort{"laser_serial", wires.laser_far_end, line_settings(wiring.laser_baud),
+                                   wires.laser_pty ? kPtyOpened : kNotObservable});
+    }
     switch (wiring.board_io) {
         case BoardIoWireKind::dds: break;
         case BoardIoWireKind::modbus_rtu:
@@ -97,11 +101,13 @@ nlohmann::json board_scalings_json(const CaseSpec& spec) {
 }
 
 void announce_attach(const CaseSpec& spec, const BenchWires& wires, const std::string& run_name,
-                     const std::filesystem::path& case_dir, std::ostream& out) {
+                     const std::filesystem::path& case_dir, std::ostream& out,
+                     std::optional<std::uint32_t> dds_domain) {
     const std::vector<AttachPort> ports = attach_ports(spec, wires);
     // The file first: whoever reacts to the line finds the file already there.
     nlohmann::json attach = attach_json(ports, run_name, spec.board);
-    attach["scalings"] = board_scalings_json(spec);
+    if (spec.system == CaseSystem::breakpoint) attach["scalings"] = board_scalings_json(spec);
+    if (dds_domain) attach["dds_domain"] = *dds_domain;
     write_file_atomically(case_dir / "attach.json", attach.dump(2) + "\n");
     out << attach_line(ports, run_name, spec.board) << std::endl;
 }
@@ -139,25 +145,31 @@ BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const st
     BoardAttachment attachment;
     modbus::ModbusSlave* slave = modbus_slave_of(wires);
     bool nmea_open = !wires.gnss_pty;  // only a pty's peer is observable
+    bool laser_open = !wires.laser_pty;
     bool modbus_heard = slave == nullptr;
+    const auto look_at_pty = [&](bool& open, const char* role, const std::string& far_end) {
+        if (open) return;
+        const std::vector<int> holders = processes_holding(far_end);
+        if (holders.empty()) return;
+        open = true;
+        attachment.seen.push_back(std::string(role) + " " + far_end + " opened by pid " + std::to_string(holders.front()) +
+                                  " after " + seconds_text(waited.elapsed_s()) + " s");
+    };
     for (;;) {
-        if (!nmea_open) {
-            const std::vector<int> holders = processes_holding(wires.gnss_far_end);
-            if (!holders.empty()) {
-                nmea_open = true;
-                attachment.seen.push_back("gnss_nmea " + wires.gnss_far_end + " opened by pid " +
-                                          std::to_string(holders.front()) + " after " + seconds_text(waited.elapsed_s()) + " s");
-            }
-        }
+        look_at_pty(nmea_open, "gnss_nmea", wires.gnss_far_end);
+        look_at_pty(laser_open, "laser_serial", wires.laser_far_end);
         if (!modbus_heard && slave->statistics().valid_requests > 0) {
             modbus_heard = true;
             attachment.seen.push_back("first valid Modbus request on " + wires.board_io_far_end + " after " +
                                       seconds_text(waited.elapsed_s()) + " s");
         }
-        if (nmea_open && modbus_heard) break;
+        if (nmea_open && laser_open && modbus_heard) break;
         if (waited.elapsed_s() > spec.board.attach_timeout_s) {
             std::string missing;
             if (!nmea_open) missing += "no process opened the GNSS NMEA line " + wires.gnss_far_end;
+            if (!laser_open) {
+                missing += std::string(missing.empty() ? "" : "; ") + "no process opened the laser line " + wires.laser_far_end;
+            }
             if (!modbus_heard) {
                 const modbus::ModbusSlaveStatistics stats = slave->statistics();
                 missing += std::string(missing.empty() ? "" : "; ") + "no valid Modbus request came on " +

@@ -5,7 +5,7 @@
 //   1. announce_attach(): one line on stdout saying where the board must attach,
 //      and the same as attach.json in the case's output directory, before case
 //      time starts;
-//   2. wait_for_board(): until the board has opened the NMEA pty and sent its
+//   2. wait_for_board(): until the board has opened the NMEA (and laser) pty and sent its
 //      first valid Modbus request, bounded by board.attach_timeout_s, else
 //      NodeFailure(board_not_attached);
 //   3. BoardSilenceWatch: during the case, a Modbus master quiet for longer than
@@ -50,8 +50,11 @@ nlohmann::json attach_json(const std::vector<AttachPort>& ports, const std::stri
 nlohmann::json board_scalings_json(const CaseSpec& spec);
 
 // Prints attach_line() on `out` (flushed) and writes attach.json into case_dir.
+// `dds_domain`: the run's domain, for a board that speaks DDS itself (seed
+// 001's Pi publishing its PWM duties on DDS); attach.json `dds_domain`.
 void announce_attach(const CaseSpec& spec, const BenchWires& wires, const std::string& run_name,
-                     const std::filesystem::path& case_dir, std::ostream& out);
+                     const std::filesystem::path& case_dir, std::ostream& out,
+                     std::optional<std::uint32_t> dds_domain = std::nullopt);
 
 // Other processes holding `path` open, found in /proc/*/fd (this process left
 // out): their pids. Empty when none, or when /proc cannot be read.

@@ -2,14 +2,19 @@
 
 #include <csignal>
 #include <cstring>
+#include <iostream>
+#include <optional>
 
+#include "harness/board_attach.h"
 #include "harness/boundary_judge.h"
 #include "harness/boundary_world.h"
 #include "harness/case_session.h"
 #include "harness/dds_security_setup.h"
+#include "harness/realtime_case_loop.h"
 #include "harness/run_interrupt.h"
 #include "harness/trace_recorder.h"
 #include "rig/runtime/lockstep.h"
+#include "rig/wire/wire_adapters.h"
 
 namespace rig::harness {
 namespace {
@@ -89,7 +94,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         std::filesystem::create_directories(case_dir / "controller-state");
         const BoundaryCaseSpec& boundary = *spec.boundary;
         const BoundaryWorld world(boundary, seed);
-        CaseSession session(spec, case_dir, options.domain);
+        CaseSession session(spec, case_dir, options.domain, options.open_hid);
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
         session.start_controller(spec, options.controller_executable.parent_path() / kBoundaryControllerExecutable, case_dir,
                                  dds_security_environment(options.dds_security_dir, kControllerIdentity));
@@ -113,17 +118,40 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                                 kIdleTruthRateHz);
         Ad300Node ad300(world.kinematics, world.ad300);
         L4LaserNode laser(world.kinematics, world.laser);
+        // The bench wires' adapters (real time only), after the devices whose lines they carry.
+        std::vector<Node*> nodes = {&plant, &ad300, &laser};
+        BenchWires& wires = session.wires();
+        std::optional<NmeaSerialAdapter> nmea_adapter;
+        std::optional<LaserSerialAdapter> laser_adapter;
+        std::optional<NozzlePwmCaptureAdapter> pwm_capture;
+        if (wires.gnss_port) nodes.push_back(&nmea_adapter.emplace(*wires.gnss_port));
+        if (wires.laser_port) nodes.push_back(&laser_adapter.emplace(*wires.laser_port));
+        if (auto* hid = dynamic_cast<HidBoardWire*>(wires.board_io.get())) {
+            nodes.push_back(&pwm_capture.emplace(hid->board(), boundary.flow_table_or_paper().nozzle_count(),
+                                                 spec.wiring.board_update_hz));
+        }
+        // A wired Pi whose PWM comes on DDS (board_io: dds) must know the run's domain.
+        if (spec.wiring.external_controller) {
+            const bool pwm_on_dds = spec.wiring.board_io == BoardIoWireKind::dds;
+            announce_attach(spec, wires, run_name, case_dir, std::cout,
+                            pwm_on_dds ? std::optional<std::uint32_t>(session.domain_id()) : std::nullopt);
+        }
 
         TimeNs now_ns = 0;
         double startup_wall_s = 0.0;
+        nlohmann::json realtime_facts;
+        if (options.clock != nullptr) options.clock->end_ns.store(world.end_ns, std::memory_order_relaxed);
         const TraceOutcome outcome = session.run_to_outcome(
             [&] {
+                if (spec.mode == RunMode::realtime) {
+                    run_case_in_realtime(spec, dds, nodes, session, trace, wall, world.end_ns, now_ns, options.clock,
+                                         realtime_facts);
+                    return;
+                }
                 LockstepTimeouts timeouts;
                 timeouts.ack = std::chrono::milliseconds(static_cast<long>(spec.timeouts.node_ack_s * 1000));
                 LockstepMaster master(dds, timeouts);
-                for (Node* node : {static_cast<Node*>(&plant), static_cast<Node*>(&ad300), static_cast<Node*>(&laser)}) {
-                    master.add_local_node(*node);
-                }
+                for (Node* node : nodes) master.add_local_node(*node);
                 if (session.has_controller_process()) {
                     master.add_remote_node("controller", [&session] { return session.controller_gone(); });
                 }
@@ -155,13 +183,15 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         // Seed 001's reference controller ships as a program only: --in-process
         // leaves these cases to it, and says so.
         const bool asked_in_process = spec.controller.in_process.value_or(options.in_process);
-        trace.file().set_meta("run", nlohmann::json{{"wall_seconds", wall.elapsed_s()},
-                                                    {"controller_mode", session.controller_mode()},
-                                                    {"in_process_refused", asked_in_process
-                                                         ? "seed 001's boundary controller has no plugin" : ""},
-                                                    {"startup_wall_seconds", startup_wall_s},
-                                                    {"plant_rejected_duty_commands", plant.rejected_commands()}}
-                                         .dump());
+        nlohmann::json run_facts = realtime_facts.is_object()
+                                       ? realtime_facts
+                                       : nlohmann::json{{"wall_seconds", wall.elapsed_s()},
+                                                        {"controller_mode", session.controller_mode()},
+                                                        {"startup_wall_seconds", startup_wall_s}};
+        run_facts["in_process_refused"] = asked_in_process ? "seed 001's boundary controller has no plugin" : "";
+        run_facts["plant_rejected_duty_commands"] = plant.rejected_commands();
+        if (pwm_capture) run_facts["nozzle_pwm_captured"] = pwm_capture->published();
+        trace.file().set_meta("run", run_facts.dump());
         trace.file().finish(outcome);
     } catch (const std::exception& error) {
         const FailureKind kind = run_interrupt_signal() ? FailureKind::interrupted : FailureKind::harness_error;

@@ -6,6 +6,11 @@
 // and the verdict from the trace alone (harness/judge.h, which hands the
 // boundary metrics to harness/boundary_judge.h). The same shape as seed 000's
 // run (harness/case_runner.cpp): its session, its DDS domain, its trace.
+// `mode: realtime` runs the same nodes on seed 000's real-time loop
+// (harness/realtime_case_loop.h) with the case's `wiring:`: the AD300's RMC
+// and the L4's lines on serial lines (NmeaSerialAdapter, LaserSerialAdapter),
+// the nozzle PWM on DDS or from the HID board's capture
+// (NozzlePwmCaptureAdapter, `board_io: hid`, with `controller: external`).
 #include <cstdint>
 #include <string>
 

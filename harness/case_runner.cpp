@@ -24,6 +24,7 @@
 #include "harness/case_session.h"
 #include "harness/case_world.h"
 #include "harness/dds_security_setup.h"
+#include "harness/realtime_case_loop.h"
 #include "harness/run_interrupt.h"
 #include "harness/run_progress.h"
 #include "harness/trace_recorder.h"
@@ -285,13 +286,13 @@ std::string raise_wire_threads(BenchWires& wires, int priority) {
 }
 
 // Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
-void run_realtime(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, CaseSession& session,
+void run_realtime(const CaseSpec& spec, DdsContext& dds, const std::vector<Node*>& nodes, CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
     facts.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
     facts.realtime_scheduling += raise_wire_threads(session.wires(), kWireThreadPriority);
     RealtimeMaster master(dds, timeouts_of(spec));
-    for (Node* node : nodes.all) master.add_local_node(*node);
+    for (Node* node : nodes) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });
     if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(session.wires().board_io.get())) {
         modbus_wire->set_wake([&dds] { dds.notify_data_arrived(); });
@@ -393,6 +394,25 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
 
 }  // namespace
 
+void run_case_in_realtime(const CaseSpec& spec, DdsContext& dds, const std::vector<Node*>& nodes, CaseSession& session,
+                          TraceRecorder& trace, const WallStopwatch& wall, TimeNs end_ns, TimeNs& now_ns,
+                          CaseClock* clock, nlohmann::json& run_facts) {
+    RunFacts facts;
+    facts.controller_mode = session.controller_mode();
+    Watchdog watchdog(spec, wall, dds, trace, session, now_ns, clock);
+    const auto record_facts = [&] {
+        facts.board_io = board_io_report(spec, session.wires(), facts.board_attachment);
+        run_facts = run_facts_json(facts, wall.elapsed_s());
+    };
+    try {
+        run_realtime(spec, dds, nodes, session, trace, watchdog, end_ns, now_ns, facts, wall);
+    } catch (...) {
+        record_facts();
+        throw;
+    }
+    record_facts();
+}
+
 void validate_for_run(const CaseSpec& spec, const RunOptions& options) {
     // A wired board's valve commands come over its wire, and the rig's own
     // bridge puts them on the actuator topics, which the rig's identity may
@@ -458,7 +478,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
 
         const CaseWorld world = build_case_world(spec, seed);
         emulators::SprayCircuit circuit(world.plant, world.circuit);
-        CaseSession session(spec, case_dir, options.domain);
+        CaseSession session(spec, case_dir, options.domain, options.open_hid);
         // The harness's participant first, watching discovery; then the
         // controller, so every endpoint it makes is seen.
         DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
@@ -497,7 +517,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
                 if (spec.mode == RunMode::lockstep) {
                     run_lockstep(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
                 } else {
-                    run_realtime(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
+                    run_realtime(spec, dds, nodes.all, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
                 }
                 circuit.advance_to(world.end_ns);
             },

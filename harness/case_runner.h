@@ -17,6 +17,7 @@
 
 #include "harness/case_spec.h"
 #include "harness/judge.h"
+#include "rig/wire/hid_board.h"
 
 namespace rig::harness {
 
@@ -55,6 +56,9 @@ struct RunOptions {
     // Where run_case publishes the case's clock as it runs (a progress display);
     // nullptr: nowhere. run_cases sets it per case from its RunObserver.
     CaseClock* clock = nullptr;
+    // `board_io: hid`: how the board is opened; empty = hidapi by the case's
+    // hid_vid / hid_pid (a test hands an in-process board here).
+    HidTransportOpener open_hid;
 };
 
 // Checks that need more than the file itself (e.g. the reference controller's

@@ -44,31 +44,46 @@ modbus::CommsFailsafe comms_failsafe(const BoardSpec& board) {
     return {std::chrono::milliseconds(std::lround(board.failsafe_timeout_s * 1000.0)), board.failsafe};
 }
 
+// A serial line the rig writes: `port` is "pty" (a pseudo-terminal made here)
+// or a device path. Sets `writer` to the rig's end; returns the far end's path.
+std::string open_serial_line(const std::string& port, int baud, std::unique_ptr<PtyPair>& pty,
+                             std::unique_ptr<SerialPort>& device, SerialPort*& writer) {
+    SerialSettings line;
+    line.baud = baud;
+    if (port == "pty") {
+        pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
+        writer = &pty->master();
+        return pty->slave_path();
+    }
+    device = std::make_unique<SerialPort>(port, line);
+    writer = device.get();
+    return port;
+}
+
 }  // namespace
 
-BenchWires open_bench_wires(const CaseSpec& spec) {
+BenchWires open_bench_wires(const CaseSpec& spec, const HidTransportOpener& open_hid) {
     BenchWires wires;
     const WiringSpec& wiring = spec.wiring;
     std::vector<std::string> parts;
     if (wiring.gnss == GnssWire::serial) {
-        SerialSettings line;
-        line.baud = wiring.nmea_baud;
-        std::string far_end;
-        if (wiring.gnss_port == "pty") {
-            wires.gnss_pty = std::make_unique<PtyPair>(PtyOptions{line, {}});
-            wires.gnss_port = &wires.gnss_pty->master();
-            far_end = wires.gnss_pty->slave_path();
-        } else {
-            wires.gnss_device = std::make_unique<SerialPort>(wiring.gnss_port, line);
-            wires.gnss_port = wires.gnss_device.get();
-            far_end = wiring.gnss_port;
-        }
+        const std::string far_end =
+            open_serial_line(wiring.gnss_port, wiring.nmea_baud, wires.gnss_pty, wires.gnss_device, wires.gnss_port);
         wires.gnss_far_end = far_end;
         wires.controller_args.insert(wires.controller_args.end(),
                                      {"--nmea-serial", far_end, "--nmea-baud", std::to_string(wiring.nmea_baud)});
         parts.push_back("gnss serial " + far_end + " " + std::to_string(wiring.nmea_baud) + " baud");
     } else {
         parts.push_back("gnss dds");
+    }
+    if (wiring.laser == GnssWire::serial) {
+        wires.laser_far_end = open_serial_line(wiring.laser_port, wiring.laser_baud, wires.laser_pty,
+                                               wires.laser_device, wires.laser_port);
+        wires.controller_args.insert(wires.controller_args.end(), {"--laser-serial", wires.laser_far_end,
+                                                                   "--laser-baud", std::to_string(wiring.laser_baud)});
+        parts.push_back("laser serial " + wires.laser_far_end + " " + std::to_string(wiring.laser_baud) + " baud");
+    } else if (spec.system == CaseSystem::boundary) {
+        parts.push_back("laser dds");
     }
     switch (wiring.board_io) {
         case BoardIoWireKind::dds: parts.push_back("board_io dds"); break;
@@ -107,7 +122,8 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
         }
         case BoardIoWireKind::hid: {
             // A real bench board; the controller is wired to it, not to the rig process.
-            auto transport = HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
+            std::unique_ptr<HidTransport> transport = open_hid ? open_hid(wiring.hid_vid, wiring.hid_pid)
+                                                               : HidapiTransport::open(wiring.hid_vid, wiring.hid_pid);
             const std::string description = transport->description();
             wires.board_io_far_end = description;
             wires.board_io = std::make_unique<HidBoardWire>(std::make_unique<HidBoard>(std::move(transport)), description);
@@ -123,8 +139,8 @@ BenchWires open_bench_wires(const CaseSpec& spec) {
 
 
 CaseSession::CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
-                         std::optional<std::uint32_t> domain)
-    : wires_(open_bench_wires(spec)),
+                         std::optional<std::uint32_t> domain, const HidTransportOpener& open_hid)
+    : wires_(open_bench_wires(spec, open_hid)),
       lease_(domain ? DomainLease::acquire_exact(*domain) : spec.domain ? DomainLease::acquire_exact(*spec.domain)
                                                                          : DomainLease::acquire()),
       controller_log_(case_dir / "controller.log") {}
@@ -133,8 +149,11 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
                                    const std::filesystem::path& case_dir, const std::vector<std::string>& environment) {
     // The controller under test, in its own process on this run's own domain
     // (none when a real board is wired up: `wiring: { controller: external }`).
-    if (spec.wiring.external_controller || controller_ || in_process_) return;
+    if (controller_ || in_process_) return;
+    // An external board is given the same file beside attach.json: a seed-001
+    // Pi takes its areas and mounting from it.
     write_controller_config(spec, case_dir / "controller.yaml");
+    if (spec.wiring.external_controller) return;
     std::vector<std::string> argv = spec.controller.command;
     if (argv.empty()) {
         argv.push_back(controller_executable.string());
@@ -219,23 +238,35 @@ std::string CaseSession::controller_log_tail(std::size_t max_lines) const {
     return controller_ || in_process_ ? log_tail(controller_log_, max_lines) : std::string();
 }
 
-std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {
-    if (!wires_.gnss_pty) return {};
-    const std::size_t unread = wires_.gnss_pty->unread_bytes();
+std::string CaseSession::unread_problem(PtyPair* pty, const std::string& line, const std::string& far_end,
+                                        const std::string& what, UnreadWatch& watch,
+                                        std::chrono::milliseconds unread_for) {
+    if (pty == nullptr) return {};
+    const std::size_t unread = pty->unread_bytes();
     // Bytes waiting is normal between reads; bytes waiting that never go down
     // mean nobody has the line open, or nobody reads it.
-    if (unread == 0 || unread < gnss_unread_) {
-        gnss_unread_since_.reset();
-    } else if (!gnss_unread_since_) {
-        gnss_unread_since_.emplace();
+    if (unread == 0 || unread < watch.unread) {
+        watch.since.reset();
+    } else if (!watch.since) {
+        watch.since.emplace();
     }
-    gnss_unread_ = unread;
-    if (gnss_unread_since_ && gnss_unread_since_->elapsed() > unread_for) {
-        return "nobody reads the GNSS line " + wires_.gnss_far_end + ": " + std::to_string(unread) +
-               " bytes of NMEA written to it have waited unread for more than " +
-               std::to_string(unread_for.count()) + " ms (is the board attached to that port?)";
+    watch.unread = unread;
+    if (watch.since && watch.since->elapsed() > unread_for) {
+        return "nobody reads the " + line + " line " + far_end + ": " + std::to_string(unread) + " bytes of " + what +
+               " written to it have waited unread for more than " + std::to_string(unread_for.count()) +
+               " ms (is the board attached to that port?)";
     }
     return {};
+}
+
+std::string CaseSession::wire_problem(std::chrono::milliseconds unread_for) {
+    std::string problem =
+        unread_problem(wires_.gnss_pty.get(), "GNSS", wires_.gnss_far_end, "NMEA", gnss_watch_, unread_for);
+    if (problem.empty()) {
+        problem = unread_problem(wires_.laser_pty.get(), "laser", wires_.laser_far_end, "laser lines", laser_watch_,
+                                 unread_for);
+    }
+    return problem;
 }
 
 }  // namespace rig::harness

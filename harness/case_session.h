@@ -32,6 +32,11 @@ struct BenchWires {
     std::unique_ptr<SerialPort> gnss_device;
     SerialPort* gnss_port = nullptr;  // the rig writes NMEA here
     std::string gnss_far_end;         // what the controller opens
+    // Seed 001's L4 laser line (`laser: serial`), like the GNSS's.
+    std::unique_ptr<PtyPair> laser_pty;
+    std::unique_ptr<SerialPort> laser_device;
+    SerialPort* laser_port = nullptr;  // the rig writes the laser's lines here
+    std::string laser_far_end;
     std::unique_ptr<PtyLink> modbus_link;
     std::unique_ptr<BoardIoWire> board_io;
     std::string board_io_far_end;     // what the controller opens: a tty path or ADDRESS:PORT
@@ -41,14 +46,15 @@ struct BenchWires {
     std::shared_ptr<emulators::RtuLineNoise> line_noise;
 };
 // Opens what spec.wiring asks for; throws std::runtime_error naming the port.
-BenchWires open_bench_wires(const CaseSpec& spec);
+// `open_hid`: how a HID board is opened (empty: hidapi, rig/wire/hid_board.h).
+BenchWires open_bench_wires(const CaseSpec& spec, const HidTransportOpener& open_hid = {});
 
 class CaseSession {
 public:
     // Opens the wires and takes a DDS domain. Throws std::runtime_error naming
     // what could not be opened.
     CaseSession(const CaseSpec& spec, const std::filesystem::path& case_dir,
-                std::optional<std::uint32_t> domain = std::nullopt);
+                std::optional<std::uint32_t> domain = std::nullopt, const HidTransportOpener& open_hid = {});
     // Writes the controller's configuration into case_dir and starts the
     // controller with the wires' far ends (unless the case wires an external
     // board). Called once the harness's participant exists on the domain, so
@@ -84,8 +90,9 @@ public:
     TraceOutcome run_to_outcome(const std::function<void()>& run, TimeNs end_ns, const TimeNs& now_ns);
     // The last lines of the controller's log, for error messages.
     std::string controller_log_tail(std::size_t max_lines = 6) const;
-    // A bench wire whose far end does not take what the rig writes: the GNSS pty
-    // holding bytes nobody read for longer than `unread_for`. Empty when fine.
+    // A bench wire whose far end does not take what the rig writes: the GNSS
+    // (or laser) pty holding bytes nobody read for longer than `unread_for`.
+    // Empty when fine.
     std::string wire_problem(std::chrono::milliseconds unread_for);
 
 private:
@@ -94,9 +101,15 @@ private:
     std::filesystem::path controller_log_;
     std::optional<ChildProcess> controller_;
     std::unique_ptr<InProcessController> in_process_;
-    // GNSS pty watch: the unread byte count, and since when it has not gone down.
-    std::size_t gnss_unread_ = 0;
-    std::optional<WallStopwatch> gnss_unread_since_;
+    // A pty's watch: the unread byte count, and since when it has not gone down.
+    struct UnreadWatch {
+        std::size_t unread = 0;
+        std::optional<WallStopwatch> since;
+    };
+    static std::string unread_problem(PtyPair* pty, const std::string& line, const std::string& far_end,
+                                      const std::string& what, UnreadWatch& watch, std::chrono::milliseconds unread_for);
+    UnreadWatch gnss_watch_;
+    UnreadWatch laser_watch_;
 };
 
 }  // namespace rig::harness

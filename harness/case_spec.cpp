@@ -4,6 +4,7 @@
 #include "harness/boundary_case.h"
 #include "rig/config/file_access.h"
 #include "rig/runtime/failure_kind.h"
+#include "rig/wire/hid_board_protocol.h"
 #include "rig/wire/modbus_protocol.h"
 
 #include <algorithm>
@@ -384,8 +385,13 @@ std::string read_port(const YamlSection& section, std::string_view key, const st
     return port;
 }
 
-WiringSpec read_wiring(const YamlSection& section) {
+WiringSpec read_wiring(const YamlSection& section, CaseSystem system) {
     WiringSpec wiring;
+    if (system == CaseSystem::boundary) {
+        wiring.laser = section.optional_enum<GnssWire>("laser", kGnssWires, wiring.laser);
+        wiring.laser_port = read_port(section, "laser_port", wiring.laser_port);
+        wiring.laser_baud = section.optional_in_range<int>("laser_baud", wiring.laser_baud, Bounds::closed(1200, 4000000));
+    }
     wiring.gnss = section.optional_enum<GnssWire>("gnss", kGnssWires, wiring.gnss);
     wiring.board_io = section.optional_enum<BoardIoWireKind>("board_io", kBoardIoWires, wiring.board_io);
     wiring.gnss_port = read_port(section, "gnss_port", wiring.gnss_port);
@@ -524,6 +530,25 @@ TimeoutsSpec read_timeouts(const YamlSection& section) {
     return timeouts;
 }
 
+// The wires, the real-time sections and the board, seed 000's and seed 001's alike.
+void check_bench_wiring(const CaseSpec& spec, const YamlSection& root) {
+    if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
+        root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
+    }
+    if (spec.board.line_noise.any() && spec.wiring.board_io != BoardIoWireKind::modbus_rtu) {
+        root.section("board").fail("line_noise", "line noise is injected on a Modbus RTU line: needs `wiring: { "
+                                                 "board_io: modbus_rtu }`");
+    }
+    for (const char* section : {"realtime", "rig_faults"}) {
+        if (root.has(section) && spec.mode != RunMode::realtime) {
+            root.fail(section, "bounds and faults of the rig's real-time loop: only with `mode: realtime`");
+        }
+    }
+    if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
+        root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
+    }
+}
+
 // Checks between sections; run after finish(), when every value is real.
 void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                         const std::map<std::string, double>& default_limits) {
@@ -553,21 +578,7 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                                                         number_text(terrain_m) + " m of ground is modelled");
         }
     }
-    if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
-        root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
-    }
-    if (spec.board.line_noise.any() && spec.wiring.board_io != BoardIoWireKind::modbus_rtu) {
-        root.section("board").fail("line_noise", "line noise is injected on a Modbus RTU line: needs `wiring: { "
-                                                 "board_io: modbus_rtu }`");
-    }
-    for (const char* section : {"realtime", "rig_faults"}) {
-        if (root.has(section) && spec.mode != RunMode::realtime) {
-            root.fail(section, "bounds and faults of the rig's real-time loop: only with `mode: realtime`");
-        }
-    }
-    if (spec.wiring.external_controller && !spec.wiring.uses_bench_wire()) {
-        root.section("wiring").fail("controller", "an external controller needs a bench wire (gnss: serial, board_io: ...)");
-    }
+    check_bench_wiring(spec, root);
     if (spec.controller.in_process.value_or(false)) {
         // In process, the controller is stepped by the lockstep master: there is
         // no process boundary, so no wall clock and no bench wire to drive it.
@@ -677,8 +688,36 @@ CaseSpec read_boundary_system_case(const YamlSection& root, CaseSpec spec) {
     spec.paper = read_paper(root.section("paper"));
     spec.expect = read_expect(root.section("expect"));
     spec.timeouts = read_timeouts(root.section("timeouts"));
+    spec.wiring = read_wiring(root.section("wiring"), spec.system);
+    spec.board = read_board_spec(root.section("board"));
+    spec.realtime = read_realtime_section(root.section("realtime"));
+    spec.rig_faults = read_rig_faults(root.section("rig_faults"));
     root.finish();
-    if (spec.mode != RunMode::lockstep) root.fail("mode", "boundary cases run in lockstep (no bench wires yet)");
+    check_bench_wiring(spec, root);
+    // The Pi's outputs are six PWM lines, measured by the HID board's capture
+    // (docs/hid-io-board.md), or its duties on DDS: it has no Modbus I/O.
+    if (spec.wiring.board_io == BoardIoWireKind::modbus_rtu || spec.wiring.board_io == BoardIoWireKind::modbus_tcp) {
+        root.section("wiring").fail("board_io", "seed 001's nozzle PWM comes on DDS or through the HID board's capture: "
+                                                "dds or hid");
+    }
+    // The capture publishes actuator/nozzle_pwm/duty for the wired board: a
+    // controller process beside it would be a second writer of that topic.
+    if (spec.wiring.board_io == BoardIoWireKind::hid && !spec.wiring.external_controller) {
+        root.section("wiring").fail("board_io", "the HID board captures a wired controller's PWM: needs `controller: external`");
+    }
+    if (spec.wiring.board_io == BoardIoWireKind::hid) {
+        // rig/wire/wire_adapters.h NozzlePwmCaptureAdapter: six capture inputs, read at most at 1 kHz.
+        if (spec.wiring.board_update_hz > 1000.0) {
+            root.section("wiring").fail("board_update_hz", "the PWM capture is read at most 1000 times a second, got " +
+                                                               number_text(spec.wiring.board_update_hz));
+        }
+        const int nozzles = boundary->flow_table_or_paper().nozzle_count();
+        if (nozzles > hid::kPwmCaptureInputs) {
+            root.section("wiring").fail("board_io", "the HID board captures " + std::to_string(hid::kPwmCaptureInputs) +
+                                                        " PWM inputs; this sprayer has " + std::to_string(nozzles) +
+                                                        " nozzles");
+        }
+    }
     check_boundary_case(*boundary, root);
     for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
         if (!spec.limits.contains(spec.expect.fail[index])) {
@@ -757,7 +796,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.boom_height_sensor = read_boom_height_sensor(root.section("boom_height_sensor"));
     spec.deposition = read_deposition(root.section("deposition"));
     spec.static_flow = read_static_flow(root.section("static_flow"));
-    spec.wiring = read_wiring(root.section("wiring"));
+    spec.wiring = read_wiring(root.section("wiring"), spec.system);
     spec.board = read_board_spec(root.section("board"));
     spec.realtime = read_realtime_section(root.section("realtime"));
     spec.rig_faults = read_rig_faults(root.section("rig_faults"));

@@ -245,7 +245,15 @@ struct WiringSpec {
     // process: the harness starts the controller command with the wire's ports;
     // external: a real board is wired up and running; the harness starts nothing.
     bool external_controller = false;
-    bool uses_bench_wire() const { return gnss != GnssWire::dds || board_io != BoardIoWireKind::dds; }
+    // Seed 001 (`system: boundary`) only: the L4 laser's line, like the GNSS's
+    // (dds, or serial on `laser_port` at `laser_baud`: 115200 8N1, assumed as
+    // the AD300's; the paper gives neither).
+    GnssWire laser = GnssWire::dds;
+    std::string laser_port = "pty";
+    int laser_baud = 115200;
+    bool uses_bench_wire() const {
+        return gnss != GnssWire::dds || laser != GnssWire::dds || board_io != BoardIoWireKind::dds;
+    }
 };
 std::string_view to_string(GnssWire wire);
 std::string_view to_string(BoardIoWireKind wire);

@@ -88,6 +88,47 @@ TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
     EXPECT_NE(load_error(edited("system: boundary", "system: boundry")).find("did you mean 'boundary'"), std::string::npos);
 }
 
+// The bench path's keys (docs/seed001-boundary.md "Bench path"): the shipped
+// wired case reads as written; each wire that cannot work is refused at its key.
+TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {
+    const CaseSpec wired = parse_case(shipped("bench-wired/seed001-drive-out-wired.yaml"), "drive-out-wired.yaml");
+    EXPECT_EQ(wired.mode, RunMode::realtime);
+    EXPECT_EQ(wired.wiring.gnss, GnssWire::serial);
+    EXPECT_EQ(wired.wiring.laser, GnssWire::serial);
+    EXPECT_EQ(wired.wiring.laser_port, "pty");
+    EXPECT_EQ(wired.wiring.board_io, BoardIoWireKind::dds);
+    EXPECT_FALSE(wired.wiring.external_controller);
+    EXPECT_DOUBLE_EQ(wired.realtime.max_lateness_ms, 100.0);
+
+    const auto with = [&](const std::string& extra) { return edited("seeds: [1, 2, 3]\n", "seeds: [1, 2, 3]\n" + extra); };
+    // Real time on DDS wires only is a case of its own (no wire, no attach).
+    EXPECT_EQ(load_error(with("mode: realtime\n")), "(accepted)");
+    // A serial line has no virtual time.
+    const std::string lockstep = load_error(with("wiring: { laser: serial }\n"));
+    EXPECT_NE(lockstep.find("wiring"), std::string::npos) << lockstep;
+    EXPECT_NE(lockstep.find("mode: realtime"), std::string::npos) << lockstep;
+    // The Pi has no Modbus I/O.
+    const std::string modbus = load_error(with("mode: realtime\nwiring: { gnss: serial, board_io: modbus_rtu }\n"));
+    EXPECT_NE(modbus.find("wiring.board_io"), std::string::npos) << modbus;
+    // The capture is a wired board's PWM: a controller process would be a second writer.
+    const std::string hid = load_error(with("mode: realtime\nwiring: { gnss: serial, board_io: hid }\n"));
+    EXPECT_NE(hid.find("controller: external"), std::string::npos) << hid;
+    EXPECT_EQ(load_error(with("mode: realtime\nwiring: { gnss: serial, laser: serial, board_io: hid, controller: external }\n")),
+              "(accepted)");
+    // The capture is read at most at 1 kHz.
+    const std::string rate =
+        load_error(with("mode: realtime\nwiring: { gnss: serial, board_io: hid, controller: external, board_update_hz: 1500 }\n"));
+    EXPECT_NE(rate.find("wiring.board_update_hz"), std::string::npos) << rate;
+    // An external board needs a wire to attach to.
+    EXPECT_NE(load_error(with("mode: realtime\nwiring: { controller: external }\n")).find("bench wire"), std::string::npos);
+    // A misspelt value and a bad baud, at their keys.
+    EXPECT_NE(load_error(with("mode: realtime\nwiring: { laser: serail }\n")).find("wiring.laser"), std::string::npos);
+    EXPECT_NE(load_error(with("mode: realtime\nwiring: { laser: serial, laser_baud: 7 }\n")).find("wiring.laser_baud"),
+              std::string::npos);
+    // The real-time bound belongs to real-time runs.
+    EXPECT_NE(load_error(with("realtime: { max_lateness_ms: 50 }\n")).find("realtime"), std::string::npos);
+}
+
 TEST(BoundaryJudge, ThePlanSurvivesTheTracesJson) {
     const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
     const BoundaryJudgingPlan plan = plan_boundary_judging(*spec.boundary);

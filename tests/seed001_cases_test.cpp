@@ -153,3 +153,16 @@ TEST(Seed001Cases, ABrokenBoundaryCaseIsRefusedNamingTheKey) {
 }
 
 }  // namespace
+
+// rig-boundary-controller's wired mode (the bench path's serial lines) runs on
+// the wall clock only: asked for in lockstep it refuses before joining DDS.
+TEST(Seed001Cases, TheControllersWiredModeRefusesVirtualTime) {
+    const fs::path dir = fresh_dir("wired-lockstep");
+    std::ofstream(dir / "controller.yaml") << "{}\n";
+    const rig::testing::ShellResult refused = rig::testing::run_shell(
+        "'" RIG_BINARY_DIR "/bin/rig-boundary-controller' --domain 0 --config '" + (dir / "controller.yaml").string() +
+        "' --nmea-serial /dev/null 2>&1");
+    EXPECT_EQ(refused.exit_code, 2) << refused.output;
+    EXPECT_NE(refused.output.find("wired mode runs on the wall clock: add --clock realtime"), std::string::npos)
+        << refused.output;
+}

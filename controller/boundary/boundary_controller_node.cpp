@@ -1,22 +1,45 @@
 #include "controller/boundary/boundary_controller_node.h"
 
+#include <algorithm>
 #include <iostream>
 
 #include "idl/topics.h"
 
 namespace rig::controller::boundary {
 
-BoundaryControllerNode::BoundaryControllerNode(std::string node_name, BoundaryNodeConfig config)
-    : name_(std::move(node_name)), sweep_(std::move(config.calibration)), logic_(std::move(config.controller)) {}
+BoundaryControllerNode::BoundaryControllerNode(std::string node_name, BoundaryNodeConfig config,
+                                               BoundarySerialLines serial)
+    : name_(std::move(node_name)),
+      serial_(std::move(serial)),
+      sweep_(std::move(config.calibration)),
+      logic_(std::move(config.controller)) {}
 
 void BoundaryControllerNode::configure(DdsContext& dds) {
-    nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
-    laser_reader_ = std::make_unique<Reader<msg::SerialLine>>(dds, topics::kLaserHeightSerial);
+    // A wired input is a port, not a subscription: the node then never reads that topic.
+    if (serial_.nmea_port.empty()) {
+        nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
+    } else {
+        nmea_port_ = std::make_unique<SerialPort>(serial_.nmea_port, serial_.nmea_line);
+    }
+    if (serial_.laser_port.empty()) {
+        laser_reader_ = std::make_unique<Reader<msg::SerialLine>>(dds, topics::kLaserHeightSerial);
+    } else {
+        laser_port_ = std::make_unique<SerialPort>(serial_.laser_port, serial_.laser_line);
+    }
     pwm_writer_ = std::make_unique<Writer<msg::NozzlePwm>>(dds, topics::kNozzlePwm);
 }
 
 bool BoundaryControllerNode::has_unread_input() const {
-    return nmea_reader_->has_unread() || laser_reader_->has_unread();
+    return (nmea_reader_ && nmea_reader_->has_unread()) || (laser_reader_ && laser_reader_->has_unread());
+}
+
+std::vector<std::string> BoundaryControllerNode::take_lines(SerialPort& port) {
+    std::vector<std::string> lines;
+    // read_line keeps a partial line buffered for the next poll; a hung-up peer throws, naming the port.
+    while (std::optional<std::string> line = port.read_line(std::chrono::milliseconds(0))) {
+        lines.push_back(std::move(*line));
+    }
+    return lines;
 }
 
 double BoundaryControllerNode::sweep_duty_pct(TimeNs now_ns, TimeNs& next_change_ns) const {
@@ -39,8 +62,16 @@ double BoundaryControllerNode::sweep_duty_pct(TimeNs now_ns, TimeNs& next_change
 TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
     // Fixed order (laser, then GNSS) keeps runs identical whatever the arrival
     // order across the two topics: the height is known before the fix uses it.
-    for (const auto& sample : laser_reader_->take_all()) logic_.on_laser_line(sample.text().to_string(), now_ns);
-    for (const auto& sample : nmea_reader_->take_all()) logic_.on_nmea_sentence(sample.sentence().to_string(), now_ns);
+    if (laser_reader_) {
+        for (const auto& sample : laser_reader_->take_all()) logic_.on_laser_line(sample.text().to_string(), now_ns);
+    } else {
+        for (const std::string& line : take_lines(*laser_port_)) logic_.on_laser_line(line, now_ns);
+    }
+    if (nmea_reader_) {
+        for (const auto& sample : nmea_reader_->take_all()) logic_.on_nmea_sentence(sample.sentence().to_string(), now_ns);
+    } else {
+        for (const std::string& line : take_lines(*nmea_port_)) logic_.on_nmea_sentence(line, now_ns);
+    }
     TimeNs next_wake = logic_.update(now_ns);
     std::vector<double> duty = logic_.duty_pct();
     if (!sweep_.duties_pct.empty()) {
@@ -57,6 +88,8 @@ TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
         published_duty_pct_ = duty;
         published_once_ = true;
     }
+    // A port does not wake the node when a line arrives: it is polled.
+    if (nmea_port_ || laser_port_) next_wake = std::min(next_wake, now_ns + serial_.poll_period_ns);
     return next_wake;
 }
 

@@ -7,6 +7,9 @@
 //
 // Subscriptions: device/gnss/nmea, device/laser_height/serial
 // Publications:  actuator/nozzle_pwm/duty
+// Wired (the bench path, real time only): the RMC and laser lines come from
+// serial ports instead of those two topics, as the Pi's UARTs have them; the
+// PWM duty still goes out on DDS.
 // With a `calibration:` sweep (boundary_node_config.h) it holds the sweep's
 // duties on every nozzle instead, as the paper's Table 3 measurement did.
 #include <memory>
@@ -17,12 +20,24 @@
 #include "controller/boundary/boundary_node_config.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
+#include "rig/wire/serial_port.h"
 
 namespace rig::controller::boundary {
 
+// The serial lines of the wired mode; an empty path: that input comes from DDS.
+struct BoundarySerialLines {
+    std::string nmea_port;       // the AD300's RMC (the Pi's RXD0)
+    SerialSettings nmea_line{};  // 115200 8N1 unless told
+    std::string laser_port;      // the L4's lines (the Pi's RXD3)
+    SerialSettings laser_line{};
+    // How often the ports are read: a line waits at most this long in the
+    // UART before the logic sees it (1.5 cm at 1.5 m/s).
+    TimeNs poll_period_ns = 10'000'000;
+};
+
 class BoundaryControllerNode final : public Node {
 public:
-    BoundaryControllerNode(std::string node_name, BoundaryNodeConfig config);
+    BoundaryControllerNode(std::string node_name, BoundaryNodeConfig config, BoundarySerialLines serial = {});
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
@@ -32,7 +47,13 @@ private:
     // The sweep's duty at now_ns and when it next changes.
     double sweep_duty_pct(TimeNs now_ns, TimeNs& next_change_ns) const;
 
+    // Complete lines from a wired port (without their terminators), in arrival order.
+    static std::vector<std::string> take_lines(SerialPort& port);
+
     std::string name_;
+    BoundarySerialLines serial_;
+    std::unique_ptr<SerialPort> nmea_port_;
+    std::unique_ptr<SerialPort> laser_port_;
     DutySweepConfig sweep_;
     BoundaryController logic_;
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;

@@ -12,6 +12,7 @@
 // protocol id and version of every report the device sends.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -48,6 +49,10 @@ public:
     // "1209:0001 /dev/hidraw3" or "fake board": for error messages.
     virtual std::string description() const = 0;
 };
+
+// Opens the board by USB vendor and product id (HidapiTransport::open on a
+// bench; an in-process board in a test of the whole run).
+using HidTransportOpener = std::function<std::unique_ptr<HidTransport>(std::uint16_t vendor_id, std::uint16_t product_id)>;
 
 struct HidDeviceInfo {
     std::string path;  // /dev/hidrawN

@@ -33,6 +33,22 @@ TimeNs NmeaSerialAdapter::step(TimeNs /*now_ns*/) {
     return kNever;
 }
 
+LaserSerialAdapter::LaserSerialAdapter(SerialPort& port) : port_(port) {}
+
+void LaserSerialAdapter::configure(DdsContext& dds) {
+    line_reader_ = std::make_unique<Reader<msg::SerialLine>>(dds, topics::kLaserHeightSerial);
+}
+
+bool LaserSerialAdapter::has_unread_input() const { return line_reader_->has_unread(); }
+
+TimeNs LaserSerialAdapter::step(TimeNs /*now_ns*/) {
+    for (const msg::SerialLine& line : line_reader_->take_all()) {
+        port_.write_all(line.text().to_string(), kSerialWriteTimeout);
+        ++lines_written_;
+    }
+    return kNever;
+}
+
 // ------------------------------------------------------------------ Modbus slave wire
 
 modbus::ModbusSlaveCallbacks ModbusSlaveWire::callbacks() {

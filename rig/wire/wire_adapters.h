@@ -5,7 +5,8 @@
 // device topics and the plant always takes actuator topics; an adapter node here
 // carries them over the chosen wire, so neither side changes for it.
 //
-//   NmeaSerialAdapter   device/gnss/nmea  ->  a serial port (the G970II's RS232 line)
+//   NmeaSerialAdapter   device/gnss/nmea  ->  a serial port (the G970II's RS232 line, the AD300's RMC)
+//   LaserSerialAdapter  device/laser_height/serial  ->  a serial port (seed 001's L4 laser)
 //   BoardIoAdapter      device topics     ->  the board's inputs  (io::DeviceSignals)
 //                       actuator topics   <-  the board's outputs (io::ActuatorCommands)
 //                       controller/breakpoint_event <- the board's indicator counters
@@ -52,6 +53,25 @@ private:
     SerialPort& port_;
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
     std::uint64_t sentences_written_ = 0;
+};
+
+// Writes every line published on device/laser_height/serial to a serial port,
+// byte for byte, as seed 001's L4 laser would (its terminator included).
+//   Subscriptions: device/laser_height/serial
+class LaserSerialAdapter final : public Node {
+public:
+    explicit LaserSerialAdapter(SerialPort& port);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override;
+    std::uint64_t lines_written() const { return lines_written_; }
+
+private:
+    std::string name_ = "laser_serial";
+    SerialPort& port_;
+    std::unique_ptr<Reader<msg::SerialLine>> line_reader_;
+    std::uint64_t lines_written_ = 0;
 };
 
 // One board-I/O wire, as the adapter sees it.
@@ -105,6 +125,8 @@ public:
     io::ActuatorCommands outputs() override;
     io::ControllerIndicators indicators() override;
     bool changed() override { return false; }  // polled at every input update
+    // Seed 001's capture (NozzlePwmCaptureAdapter) talks to the board itself.
+    HidBoard& board() { return *board_; }
 
 private:
     std::unique_ptr<HidBoard> board_;
