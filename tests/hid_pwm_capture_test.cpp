@@ -304,6 +304,29 @@ TEST(HidPwmCapture, ZeroAndHundredPercentAreSteadyLevels) {
     EXPECT_EQ(pwm.frequency_hz(), 0.0);
 }
 
+// Out of a steady level the first edge counts at once: a nozzle held on at 100 %
+// is shut off by one falling edge, and the valve follows the line then, not
+// steady_after_us (250 ms, 0.375 m at 1.5 m/s) later.
+TEST(HidPwmCapture, TheFirstEdgeOutOfASteadyLevelIsTakenAtOnce) {
+    Bench bench;
+    bench.fake->set_pwm_source(0, {9.0, 100.0, 0.0});
+    bench.fake->set_pwm_source(1, {9.0, 0.0, 0.0});
+    bench.fake->set_pwm_source(2, {9.0, 100.0, 0.0});
+    bench.run_us(600'000);
+    ASSERT_EQ(bench.reading(0).state, State::steady);
+    ASSERT_EQ(bench.reading(0).duty_pct, 100.0);
+    ASSERT_EQ(bench.reading(1).duty_pct, 0.0);
+    bench.fake->set_pwm_source(0, {9.0, 0.0, 0.0});    // shut off
+    bench.fake->set_pwm_source(1, {9.0, 100.0, 0.0});  // switched full on
+    bench.run_us(2 * kReadEveryUs);
+    EXPECT_EQ(bench.reading(0).duty_pct, 0.0) << "a falling edge after 100 % is 0 % from that edge";
+    EXPECT_EQ(bench.reading(1).duty_pct, 100.0) << "a rising edge after 0 % is 100 % from that edge";
+    // A PWM that starts from a steady level reads as a PWM after its first complete period.
+    bench.fake->set_pwm_source(2, {9.0, 50.0, 0.0});
+    bench.run_us(300'000);
+    expect_pwm(bench.reading(2), 50.0, 9.0, kDutyTolerancePct, "nozzle 2 from 100 % to 50 %");
+}
+
 TEST(HidPwmCapture, GlitchesAreRemovedAndABounceMovesAnEdgeByItsLength) {
     Bench bench;
     const double period_us = 1e6 / 9.0;

@@ -54,6 +54,16 @@ void PwmCapture::commit(int input, std::int64_t time_us, bool rising) {
         return;
     }
     in.level = rising;
+    NozzlePwmReading& held = readings_[static_cast<std::size_t>(input)];
+    if (held.state == NozzlePwmReading::State::steady) {
+        // A line held at 0 % or 100 % that changes level: the valve driver
+        // follows the line at once, so the reading does (a nozzle on at 100 %
+        // is shut off by one falling edge, and waiting steady_after_us for the
+        // next would put 0.375 m of overrun at 1.5 m/s on the controller). If
+        // a PWM starts instead, its first complete period replaces this.
+        held.duty_pct = rising ? 100.0 : 0.0;
+        held.measured_at_us = time_us;
+    }
     if (!rising) {
         if (in.last_rise) in.last_fall = time_us;
         return;

@@ -19,7 +19,10 @@
 //     measuring restarts at the next rising edge.
 //   - steady level: no edge on an input for steady_after_us while the board's
 //     report time has passed it: duty 0 % (low) or 100 % (high), frequency 0
-//     (no PWM). A controller sets 0 % and 100 % this way on a GPIO PWM.
+//     (no PWM). A controller sets 0 % and 100 % this way on a GPIO PWM. The
+//     first edge out of a steady level is taken at once (the valve follows the
+//     line): 100 % then a falling edge reads 0 % from that edge, until a PWM's
+//     first complete period says otherwise.
 //   - lost edges: an edge-report sequence gap or the board's overflow flag
 //     drops every partial period (counted); readings keep their last value
 //     until a complete period (or a steady level) replaces them.
