@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -14,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rig/host/child_process.h"
+#include "rig/runtime/clock.h"
 #include "rig/runtime/dds_security.h"
 
 namespace rig::harness {
@@ -61,15 +61,6 @@ std::string topics_element(const std::vector<std::string>& topics, const char* i
     std::string xml = std::string(indent) + "<topics>\n";
     for (const std::string& topic : topics) xml += std::string(indent) + "  <topic>" + xml_escape(topic) + "</topic>\n";
     return xml + indent + "</topics>\n";
-}
-
-std::string utc_time(std::chrono::system_clock::time_point when) {
-    const std::time_t seconds = std::chrono::system_clock::to_time_t(when);
-    std::tm utc{};
-    gmtime_r(&seconds, &utc);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &utc);
-    return text;
 }
 
 // Runs one openssl command to its end; its output goes to the run's openssl.log.
@@ -227,9 +218,9 @@ DdsSecurityRun make_dds_security_run(const std::filesystem::path& dir, const std
     std::filesystem::create_directories(dir);
     std::filesystem::permissions(dir, std::filesystem::perms::owner_all, std::filesystem::perm_options::replace);
     Openssl openssl(openssl_program, dir / "openssl.log");
-    const auto now = std::chrono::system_clock::now();
-    const std::string not_before = utc_time(now - std::chrono::hours(24 * kValidDaysBefore));
-    const std::string not_after = utc_time(now + std::chrono::hours(24 * kValidDaysAfter));
+    // The validity window is read from rig's clock (a label of the credentials, not of the trace).
+    const std::string not_before = utc_date_time_from_now(-std::chrono::hours(24 * kValidDaysBefore));
+    const std::string not_after = utc_date_time_from_now(std::chrono::hours(24 * kValidDaysAfter));
     const std::string days = std::to_string(kValidDaysAfter);
     auto new_key = [&](const std::filesystem::path& key) {
         create_private_file(key);

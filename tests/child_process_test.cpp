@@ -3,6 +3,7 @@
 // the rig itself is killed. A controller left running would sit in a DDS
 // domain the next run leases and talk to it.
 #include "rig/host/child_process.h"
+#include "rig/runtime/clock.h"
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -16,7 +17,6 @@
 #include <fstream>
 #include <vector>
 #include <string>
-#include <thread>
 
 namespace {
 
@@ -40,7 +40,7 @@ bool process_ended(pid_t pid) {
 bool eventually_ended(pid_t pid) {
     for (int i = 0; i < 2000; ++i) {
         if (process_ended(pid)) return true;
-        std::this_thread::sleep_for(5ms);
+        rig::pause_between_polls(5ms);
     }
     return false;
 }
@@ -50,7 +50,7 @@ pid_t read_pid_file(const std::string& path) {
         std::ifstream in(path);
         pid_t pid = 0;
         if (in >> pid && pid > 0) return pid;
-        std::this_thread::sleep_for(5ms);
+        rig::pause_between_polls(5ms);
     }
     return -1;
 }
@@ -77,7 +77,7 @@ TEST(ChildProcess, ALeaderThatExitsLeavesNoChildBehind) {
     std::optional<std::string> ended;
     for (int i = 0; i < 2000 && !ended; ++i) {
         ended = wrapper.exit_description();
-        if (!ended) std::this_thread::sleep_for(5ms);
+        if (!ended) rig::pause_between_polls(5ms);
     }
     ASSERT_TRUE(ended.has_value());
     EXPECT_EQ(*ended, "process exited with status 3");
@@ -105,7 +105,7 @@ TEST(ChildProcess, ACommandThatCannotStartIsNamed) {
 TEST(ChildProcess, TheLogFileGetsStdoutAndStderr) {
     const std::string log = temp_path("both.log");
     rig::ChildProcess talker({"/bin/sh", "-c", "echo out; echo err >&2"}, log);
-    for (int i = 0; i < 2000 && !talker.exit_description(); ++i) std::this_thread::sleep_for(5ms);
+    for (int i = 0; i < 2000 && !talker.exit_description(); ++i) rig::pause_between_polls(5ms);
     std::ifstream in(log);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_EQ(text, "out\nerr\n");
@@ -118,7 +118,7 @@ TEST(ChildProcess, GetsTheRigsEnvironmentWithItsOwnVariablesSetOverIt) {
     const std::string log = temp_path("environment.log");
     rig::ChildProcess printer({"/bin/sh", "-c", "echo \"$RIG_CHILD_TEST_KEPT|$RIG_CHILD_TEST_SET|$RIG_CHILD_TEST_NEW\""}, log,
                               {"RIG_CHILD_TEST_SET=the child's", "RIG_CHILD_TEST_NEW=new=with equals"});
-    for (int i = 0; i < 2000 && !printer.exit_description(); ++i) std::this_thread::sleep_for(5ms);
+    for (int i = 0; i < 2000 && !printer.exit_description(); ++i) rig::pause_between_polls(5ms);
     std::ifstream in(log);
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_EQ(text, "from the rig|the child's|new=with equals\n");
@@ -135,7 +135,7 @@ TEST(ChildProcess, InheritsNoDescriptorButItsStandardOnes) {
     ASSERT_GE(fd, 3);
     const std::string log = temp_path("fds.log");
     rig::ChildProcess lister({"/bin/sh", "-c", "ls /proc/$$/fd"}, log);
-    for (int i = 0; i < 2000 && !lister.exit_description(); ++i) std::this_thread::sleep_for(5ms);
+    for (int i = 0; i < 2000 && !lister.exit_description(); ++i) rig::pause_between_polls(5ms);
     ::close(fd);
     std::ifstream in(log);
     std::vector<std::string> fds;

@@ -48,8 +48,10 @@ std::chrono::milliseconds WallStopwatch::elapsed() const {
     return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start_);
 }
 
-std::string utc_date_time_now() {
-    const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+std::string utc_date_time_now() { return utc_date_time_from_now(std::chrono::seconds(0)); }
+
+std::string utc_date_time_from_now(std::chrono::seconds offset) {
+    const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now() + offset);
     std::tm utc{};
     gmtime_r(&now, &utc);
     char text[32];

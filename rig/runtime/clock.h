@@ -75,5 +75,8 @@ void pause_between_polls(std::chrono::milliseconds interval);
 // zone, the form JUnit XML's timestamp takes): a label for a run's reports,
 // never an input to it.
 std::string utc_date_time_now();
+// The same, `offset` from now (e.g. a certificate's validity window for the
+// run's DDS-Security credentials): a label outside the trace, never an input to it.
+std::string utc_date_time_from_now(std::chrono::seconds offset);
 
 }  // namespace rig
