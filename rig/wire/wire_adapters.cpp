@@ -9,46 +9,6 @@
 
 namespace rig {
 
-namespace {
-
-constexpr std::chrono::milliseconds kSerialWriteTimeout{1000};
-
-}  // namespace
-
-// ------------------------------------------------------------------ NMEA on a serial port
-
-NmeaSerialAdapter::NmeaSerialAdapter(SerialPort& port) : port_(port) {}
-
-void NmeaSerialAdapter::configure(DdsContext& dds) {
-    nmea_reader_ = std::make_unique<Reader<msg::NmeaSentence>>(dds, topics::kGnssNmea);
-}
-
-bool NmeaSerialAdapter::has_unread_input() const { return nmea_reader_->has_unread(); }
-
-TimeNs NmeaSerialAdapter::step(TimeNs /*now_ns*/) {
-    for (const msg::NmeaSentence& sentence : nmea_reader_->take_all()) {
-        port_.write_all(sentence.sentence().to_string(), kSerialWriteTimeout);
-        ++sentences_written_;
-    }
-    return kNever;
-}
-
-LaserSerialAdapter::LaserSerialAdapter(SerialPort& port) : port_(port) {}
-
-void LaserSerialAdapter::configure(DdsContext& dds) {
-    line_reader_ = std::make_unique<Reader<msg::SerialLine>>(dds, topics::kLaserHeightSerial);
-}
-
-bool LaserSerialAdapter::has_unread_input() const { return line_reader_->has_unread(); }
-
-TimeNs LaserSerialAdapter::step(TimeNs /*now_ns*/) {
-    for (const msg::SerialLine& line : line_reader_->take_all()) {
-        port_.write_all(line.text().to_string(), kSerialWriteTimeout);
-        ++lines_written_;
-    }
-    return kNever;
-}
-
 // ------------------------------------------------------------------ Modbus slave wire
 
 modbus::ModbusSlaveCallbacks ModbusSlaveWire::callbacks() {

@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "idl/topics.h"
 #include "rig/runtime/actuator_topics.h"
 #include "rig/runtime/board_input_topics.h"
 #include "rig/runtime/dds_context.h"
@@ -36,42 +37,52 @@
 
 namespace rig {
 
-// Writes every NMEA sentence published on device/gnss/nmea to a serial port,
-// byte for byte, as the receiver would.
-//   Subscriptions: device/gnss/nmea
-class NmeaSerialAdapter final : public Node {
+// Writes every sample of a text topic to a serial port, byte for byte, as the
+// device on that line would send it (its terminator included). `TextOf` gives
+// the sample's bytes.
+//   Subscriptions: the topic it is made for
+template <class Msg, std::string (*TextOf)(const Msg&)>
+class TextSerialAdapter : public Node {
 public:
-    explicit NmeaSerialAdapter(SerialPort& port);
+    TextSerialAdapter(SerialPort& port, std::string name, const char* topic)
+        : name_(std::move(name)), topic_(topic), port_(port) {}
     const std::string& name() const override { return name_; }
-    void configure(DdsContext& dds) override;
-    TimeNs step(TimeNs now_ns) override;
-    bool has_unread_input() const override;
-    std::uint64_t sentences_written() const { return sentences_written_; }
+    void configure(DdsContext& dds) override { reader_ = std::make_unique<Reader<Msg>>(dds, topic_); }
+    TimeNs step(TimeNs /*now_ns*/) override {
+        for (const Msg& sample : reader_->take_all()) {
+            port_.write_all(TextOf(sample), kWriteTimeout);
+            ++written_;
+        }
+        return kNever;
+    }
+    bool has_unread_input() const override { return reader_->has_unread(); }
+    // Samples written to the port so far.
+    std::uint64_t written() const { return written_; }
 
 private:
-    std::string name_ = "nmea_serial";
+    static constexpr std::chrono::milliseconds kWriteTimeout{1000};  // a line that takes no bytes for 1 s is stuck
+    std::string name_;
+    const char* topic_;
     SerialPort& port_;
-    std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
-    std::uint64_t sentences_written_ = 0;
+    std::unique_ptr<Reader<Msg>> reader_;
+    std::uint64_t written_ = 0;
 };
 
-// Writes every line published on device/laser_height/serial to a serial port,
-// byte for byte, as seed 001's L4 laser would (its terminator included).
-//   Subscriptions: device/laser_height/serial
-class LaserSerialAdapter final : public Node {
-public:
-    explicit LaserSerialAdapter(SerialPort& port);
-    const std::string& name() const override { return name_; }
-    void configure(DdsContext& dds) override;
-    TimeNs step(TimeNs now_ns) override;
-    bool has_unread_input() const override;
-    std::uint64_t lines_written() const { return lines_written_; }
+inline std::string nmea_sentence_text(const msg::NmeaSentence& sample) { return sample.sentence().to_string(); }
+inline std::string serial_line_text(const msg::SerialLine& sample) { return sample.text().to_string(); }
 
-private:
-    std::string name_ = "laser_serial";
-    SerialPort& port_;
-    std::unique_ptr<Reader<msg::SerialLine>> line_reader_;
-    std::uint64_t lines_written_ = 0;
+// The receiver's NMEA (device/gnss/nmea) on a serial port, as the G970II or AD300 sends it.
+class NmeaSerialAdapter final : public TextSerialAdapter<msg::NmeaSentence, nmea_sentence_text> {
+public:
+    explicit NmeaSerialAdapter(SerialPort& port) : TextSerialAdapter(port, "nmea_serial", topics::kGnssNmea) {}
+    std::uint64_t sentences_written() const { return written(); }
+};
+
+// Seed 001's L4 laser lines (device/laser_height/serial) on a serial port.
+class LaserSerialAdapter final : public TextSerialAdapter<msg::SerialLine, serial_line_text> {
+public:
+    explicit LaserSerialAdapter(SerialPort& port) : TextSerialAdapter(port, "laser_serial", topics::kLaserHeightSerial) {}
+    std::uint64_t lines_written() const { return written(); }
 };
 
 // One board-I/O wire, as the adapter sees it.
