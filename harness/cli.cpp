@@ -117,7 +117,7 @@ std::optional<std::vector<rig::harness::CaseSpec>> load_cases(const std::vector<
 // Refuses an output directory that cannot take results (before any case runs),
 // makes the run's DDS-Security credentials if asked, then removes what killed
 // participants of earlier runs left in /dev/shm.
-bool prepare_run(const rig::harness::RunOptions& options) {
+bool prepare_run(const rig::harness::RunOptions& options, rig::harness::Verbosity verbosity) {
     using namespace rig::harness;
     try {
         prepare_output_directory(options.out_dir);
@@ -136,7 +136,9 @@ bool prepare_run(const rig::harness::RunOptions& options) {
             return false;
         }
     }
-    if (const rig::ShmCleanup cleaned = rig::remove_dead_participant_segments(); !cleaned.removed.empty()) {
+    // Removed with --quiet too; only said without it (--quiet says only failures).
+    if (const rig::ShmCleanup cleaned = rig::remove_dead_participant_segments();
+        !cleaned.removed.empty() && verbosity != rig::harness::Verbosity::quiet) {
         std::cerr << "rig: removed " << cleaned.removed.size() << " Fast DDS shared-memory segment(s) ("
                   << cleaned.bytes_freed / 1024 << " KiB) of participants that were killed, from "
                   << rig::kPosixShmDir.string() << "\n";
@@ -165,7 +167,7 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
     // An output directory that cannot take results is refused now, not after the cases ran.
-    if (!prepare_run(options)) return 2;
+    if (!prepare_run(options, verbosity)) return 2;
     // SIGINT / SIGTERM from here on stop the cases, not the rig: the results of
     // what ran are still written (harness/run_interrupt.h).
     install_run_interrupt_handlers();
@@ -284,7 +286,7 @@ int sweep_command(const std::vector<std::string>& inputs, rig::harness::RunOptio
             return 2;
         }
     }
-    if (!prepare_run(options)) return 2;
+    if (!prepare_run(options, verbosity)) return 2;
     install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
     SweepInfo info;
