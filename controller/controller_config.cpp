@@ -40,8 +40,9 @@ void read_flow_control(const YamlSection& section, ControllerConfig& config) {
     config.pid.kd = pid.optional_in_range("kd", config.pid.kd, Bounds::closed(0.0, 100.0));
     // The PID's period is a timer: 10 ms (faster than the flow meter's window) to 5 s.
     config.pid_period_s = pid.optional_in_range("period_s", config.pid_period_s, Bounds::closed(0.01, 5.0));
-    static constexpr std::array<EnumChoice<PidOutput>, 2> kPidOutputs{
-        {{"flow_l_min", PidOutput::flow_l_min}, {"opening_pct", PidOutput::opening_pct}}};
+    static constexpr std::array<EnumChoice<PidOutput>, 3> kPidOutputs{{{"flow_l_min", PidOutput::flow_l_min},
+                                                                      {"opening_pct", PidOutput::opening_pct},
+                                                                      {"opening_step_pct", PidOutput::opening_step_pct}}};
     config.pid_output = pid.optional_enum<PidOutput>("output", kPidOutputs, config.pid_output);
     // At most the largest pump's flow (L/min).
     config.pid_integral_limit_l_min =

@@ -21,8 +21,12 @@ enum class Positioning { rtk_only, fusion };
 // What Eq. 2's output M is (the paper does not say): a flow correction in L/min,
 // through the calibration to an opening (the loop gain does not depend on where
 // on the valve curve it works), or a change of the opening in % from the
-// pre-adjusted one (the loop gain follows the curve's steepness, 1-4 L/min per %).
-enum class PidOutput { flow_l_min, opening_pct };
+// pre-adjusted one (the loop gain follows the curve's steepness, 1-4 L/min per %),
+// or a step of the opening in % each period from where the valve was last sent:
+// the firmware drives the motor for as long as M says ("the opening degree ...
+// controlled by adjusting the duration of power supply", sec. 2.1), so the
+// motor integrates M and Kp acts as an integral gain, Ki as a double one.
+enum class PidOutput { flow_l_min, opening_pct, opening_step_pct };
 
 // TEST-ONLY. Bugs a real firmware has, put into the reference controller on
 // purpose so that the rig must catch each one: the catalogue of faulty

@@ -3,10 +3,12 @@
 //   M(k) = Kp e(k) + Ki sum_{n<=k} e(n) + Kd (e(k) - e(k-1)),
 // e = target - measured main flow (L/min), evaluated once per control period.
 // The paper's gains (Kp 0.20, Ki 0.18, Kd 0.001, sec. 3.1.2) were found by trial
-// on the real sprayer; the paper does not say what M drives. In the reference
-// controller M is a flow correction in L/min: the valve is sent to the opening
-// the calibration predicts for (target + M), so the loop's gain does not change
-// with the steepness of the valve curve (1-4 L/min per % between 87 and 95 %).
+// on the real sprayer; the paper does not say what M drives. By default the
+// reference controller takes M as a flow correction in L/min: the valve is sent
+// to the opening the calibration predicts for (target + M), so the loop's gain
+// does not change with the steepness of the valve curve (1-4 L/min per % between
+// 87 and 95 %). `pid.output` picks the other readings (controller_config.h
+// PidOutput); cases/fig12-pid-tuning shows which of them reproduce Fig. 12.
 // The integral is clamped (anti-windup) so that |Ki sum e| stays within
 // integral_limit_l_min.
 namespace rig::controller {

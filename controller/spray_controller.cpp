@@ -355,6 +355,8 @@ void SprayController::regulate(TimeNs now_ns) {
     const double correction_l_min = pid_.update(error_l_min);
     if (config_.pid_output == PidOutput::opening_pct) {
         valve_command_pct_ = std::clamp(pre_adjusted_pct_ + correction_l_min, 0.0, 100.0);
+    } else if (config_.pid_output == PidOutput::opening_step_pct) {
+        valve_command_pct_ = std::clamp(valve_command_pct_ + correction_l_min, 0.0, 100.0);
     } else {
         valve_command_pct_ = calibration_.opening_for(config_.target_flow_l_min + correction_l_min, *pump_flow_l_min_);
     }

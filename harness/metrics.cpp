@@ -254,6 +254,41 @@ FlowResult flow_metrics(const std::vector<HydraulicsSample>& hydraulics, const s
         }
     }
 
+    // Fig. 12: how often the flow left the band once it had been in it, and how
+    // far it still swings at the window's end.
+    {
+        int exits = 0;
+        bool entered = false;
+        bool inside = false;
+        const TimeNs tail_from_ns = window.to_ns - seconds_to_ns(judging.oscillation_window_s);
+        double tail_min = 0.0;
+        double tail_max = 0.0;
+        bool tail_any = false;
+        bool tail_spraying = first_spraying_ns && *first_spraying_ns <= tail_from_ns;
+        for (const HydraulicsSample& sample : hydraulics) {
+            if (sample.t_ns < first_open_ns) continue;
+            if (sample.t_ns >= window.to_ns) break;
+            const bool now_inside = in_band(sample);
+            if (now_inside) entered = true;
+            if (entered && inside && !now_inside) ++exits;
+            inside = now_inside;
+            if (sample.t_ns >= tail_from_ns) {
+                if (sample.sections_spraying_mask == 0) tail_spraying = false;
+                tail_min = tail_any ? std::min(tail_min, sample.main_flow_l_min) : sample.main_flow_l_min;
+                tail_max = tail_any ? std::max(tail_max, sample.main_flow_l_min) : sample.main_flow_l_min;
+                tail_any = true;
+            }
+        }
+        metrics.values["flow_band_exits_count"] = static_cast<double>(exits);
+        if (tail_any && tail_spraying) {
+            metrics.values["flow_oscillation_pct"] = 100.0 * (tail_max - tail_min) / judging.target_l_min;
+        } else {
+            metrics.not_measured["flow_oscillation_pct"] =
+                "the nozzles did not spray through the last " + number_text(judging.oscillation_window_s, 1) +
+                " s of the judged window";
+        }
+    }
+
     // The paper's way (Table 5): the controller's own meter readings, signed.
     auto kf11_signed_error = [&](TimeNs from_ns) -> std::optional<double> {
         double sum = 0.0;

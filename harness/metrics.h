@@ -117,6 +117,9 @@ struct FlowJudging {
     // time's limit, 1.7 s by default): a flow not settled by then has its error
     // measured from then on.
     double settle_by_s = 1.7;
+    // Fig. 12's question, "does it oscillate": the flow's peak-to-peak over the
+    // last this-many seconds of the window (a sustained swing, not the approach).
+    double oscillation_window_s = 3.0;
 };
 
 struct FlowResult {
@@ -141,6 +144,14 @@ struct FlowResult {
 //                                   KF11 readings from the nozzles starting to the
 //                                   window's end, against the target (not judged)
 //   flow_error_kf11_settled_signed_pct  the same over the settled stretch only
+//   flow_band_exits_count           times the true flow left the band after it
+//                                   first entered it (1 for a pre-adjustment that
+//                                   overshoots and is trimmed back; each swing of
+//                                   an oscillation adds one)
+//   flow_oscillation_pct            peak-to-peak of the true flow over the last
+//                                   oscillation_window_s of the window, over the
+//                                   target; not measured unless the nozzles
+//                                   sprayed through all of it
 // A flow that never settles leaves the adjust times not measured, with the
 // reason: never a small number. Sections that never open leave flow_error_pct
 // not measured too.

@@ -628,6 +628,27 @@ TEST(SprayController, PidClosesACalibrationGapWithOpeningOutput) {
     expect_pid_closes_a_calibration_gap(rig::controller::PidOutput::opening_pct, "pid-opening");
 }
 
+// Eq. 2's M as a step of the opening each period (the motor driven for as long
+// as M says): the valve integrates M, so proportional control alone leaves no
+// offset; M as the opening from the pre-adjusted one leaves Kp's offset.
+TEST(SprayController, OpeningStepOutputIntegratesProportionalControlToNoOffset) {
+    auto final_flow = [](rig::controller::PidOutput output, const char* state) {
+        ControllerConfig config = static_config();
+        config.pid_output = output;
+        config.pid = {0.2, 0.0, 0.0};
+        Bench bench(config, fresh_state_dir(state), standing(), /*calibration_drift_pct=*/5.0);
+        bench.set_spray_switch(true);
+        bench.start();
+        bench.run_until(24 * kS);
+        return bench.circuit().main_flow_l_min();
+    };
+    const double stepped = final_flow(rig::controller::PidOutput::opening_step_pct, "p-only-step");
+    const double positional = final_flow(rig::controller::PidOutput::opening_pct, "p-only-positional");
+    EXPECT_NEAR(stepped, 20.0, 20.0 * 0.01);
+    // About 1 L/min over (a 5 % gap) / (1 + Kp x 2.5 L/min per % on this part of the curve).
+    EXPECT_GT(positional, 20.0 * 1.02);
+}
+
 TEST(SprayController, SwitchOnFromPowerOnGoesThroughIdleToPreAdjust) {
     Bench bench(static_config(), fresh_state_dir("switch-at-start"), standing());
     bench.set_spray_switch(true);

@@ -228,6 +228,54 @@ TEST(Kf11Readings, Eq3OnTheRecordedCountsAndCaptureTimes) {
     EXPECT_EQ(rig::harness::kf11_readings(samples, 90.0, 0.25).back().flow_l_min, 0.0);
 }
 
+// Fig. 12's "does it oscillate": the band exits after the flow first came in,
+// and the last 3 s's peak-to-peak (the window ends at 5 s: from 2 s on).
+TEST(FlowMetrics, AFlowThatComesInAndStaysNeverLeavesTheBandAndBarelySwings) {
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) {
+        if (t < 1500 * kMs) return 0.0;
+        return 20.0 + ((t / (10 * kMs)) % 2 == 0 ? 0.05 : -0.05);  // ripple of 0.1 L/min
+    }));
+    EXPECT_EQ(at(metrics, "flow_band_exits_count"), 0.0);
+    EXPECT_NEAR(at(metrics, "flow_oscillation_pct"), 0.5, 1e-9);
+}
+
+TEST(FlowMetrics, APreAdjustmentThatOvershootsAndIsTrimmedLeavesTheBandOnce) {
+    // Filling passes through the band, overshoots to 22 (10 % high), trimmed back by 3 s.
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) {
+        if (t < 1500 * kMs) return 0.0;
+        if (t < 1700 * kMs) return 20.0;
+        if (t < 3 * kS) return 22.0;
+        return 20.0;
+    }));
+    EXPECT_EQ(at(metrics, "flow_band_exits_count"), 1.0);
+    EXPECT_NEAR(at(metrics, "flow_oscillation_pct"), 10.0, 1e-9);  // 22 -> 20 lies in the last 3 s
+    EXPECT_NEAR(at(metrics, "flow_adjust_time_s"), 1.8, 1e-9);
+}
+
+TEST(FlowMetrics, ASustainedOscillationLeavesTheBandEverySwingAndNeverSettles) {
+    // +-2 L/min about the target, period 1 s, from 1.75 s on: out of the band twice a period.
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) {
+        if (t < 1750 * kMs) return 0.0;
+        const double phase = 2.0 * M_PI * static_cast<double>(t - 1750 * kMs) / static_cast<double>(kS);
+        return 20.0 + 2.0 * std::sin(phase);
+    }));
+    // In the band from 1.75 s, out at each crest and trough (2.0, 2.5, ... 5.0 s): 7 exits.
+    EXPECT_EQ(at(metrics, "flow_band_exits_count"), 7.0);
+    EXPECT_NEAR(at(metrics, "flow_oscillation_pct"), 20.0, 0.1);
+    EXPECT_EQ(at(metrics, "flow_settled"), 0.0);
+    EXPECT_EQ(metrics.not_measured.count("flow_adjust_time_s"), 1u);
+}
+
+TEST(FlowMetrics, NoOscillationFigureUnlessTheNozzlesSprayedThroughTheLastSeconds) {
+    // The sections shut at 4 s, inside the last 3 s of the window.
+    const auto metrics = flow(sampled(0, 6 * kS, [](TimeNs t) { return t >= 1500 * kMs && t < 4 * kS ? 20.0 : 0.0; },
+                                      [](TimeNs t) { return t >= 1200 * kMs && t < 4 * kS; }));
+    EXPECT_EQ(metrics.values.count("flow_oscillation_pct"), 0u);
+    ASSERT_EQ(metrics.not_measured.count("flow_oscillation_pct"), 1u);
+    EXPECT_NE(metrics.not_measured.at("flow_oscillation_pct").find("did not spray through the last 3.0 s"),
+              std::string::npos);
+}
+
 // ---------------------------------------------------------------- deposition_metrics
 
 // 400 rows of 0.05 m from -10 to +10 m (row i centred at -9.975 + 0.05 i); the
