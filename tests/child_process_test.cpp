@@ -102,6 +102,19 @@ TEST(ChildProcess, ACommandThatCannotStartIsNamed) {
     }
 }
 
+// A program that exists, with a log that cannot be opened (its directory is
+// missing): the error names the log, not the program, as what is missing.
+TEST(ChildProcess, ALogThatCannotBeOpenedIsNamedNotTheProgram) {
+    const std::string log = temp_path("no-such-directory") + "/child.log";
+    try {
+        rig::ChildProcess child({"/bin/true"}, log);
+        FAIL() << "started with a log in a directory that does not exist";
+    } catch (const std::runtime_error& error) {
+        const std::string what = error.what();
+        EXPECT_EQ(what, "cannot start '/bin/true': cannot open its log '" + log + "': No such file or directory");
+    }
+}
+
 TEST(ChildProcess, TheLogFileGetsStdoutAndStderr) {
     const std::string log = temp_path("both.log");
     rig::ChildProcess talker({"/bin/sh", "-c", "echo out; echo err >&2"}, log);

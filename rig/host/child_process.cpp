@@ -17,6 +17,9 @@
 namespace rig {
 namespace {
 
+// Where starting a child failed, reported from the child to the parent.
+enum class StartStep : int { exec = 0, null_input = 1, log = 2, descriptors = 3 };
+
 // Async-signal-safe (between fork and exec): FD_CLOEXEC on every fd from 3 up.
 bool mark_close_on_exec(int max_fd) {
     for (int fd = 3; fd < max_fd; ++fd) {
@@ -77,35 +80,55 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
         // dies too rather than living on in a DDS domain the next run will lease.
         ::prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
-        int err = 0;
+        // What failed, and its errno: a log that cannot be opened is not a
+        // missing program, and the error must say which it was.
+        int failure[2] = {static_cast<int>(StartStep::exec), 0};
         const int in = ::open("/dev/null", O_RDONLY);
-        const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (in < 0 || out < 0 || ::dup2(in, STDIN_FILENO) < 0 || ::dup2(out, STDOUT_FILENO) < 0 ||
-            ::dup2(out, STDERR_FILENO) < 0) {
-            err = errno;
-        } else if (::close_range(3, ~0U, CLOSE_RANGE_CLOEXEC) != 0 && !mark_close_on_exec(max_fd)) {
-            err = errno;
+        const int out = in < 0 ? -1 : ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (in < 0) {
+            failure[0] = static_cast<int>(StartStep::null_input);
+            failure[1] = errno;
+        } else if (out < 0) {
+            failure[0] = static_cast<int>(StartStep::log);
+            failure[1] = errno;
+        } else if (::dup2(in, STDIN_FILENO) < 0 || ::dup2(out, STDOUT_FILENO) < 0 || ::dup2(out, STDERR_FILENO) < 0 ||
+                   (::close_range(3, ~0U, CLOSE_RANGE_CLOEXEC) != 0 && !mark_close_on_exec(max_fd))) {
+            failure[0] = static_cast<int>(StartStep::descriptors);
+            failure[1] = errno;
         } else {
             // Nothing but stdin/out/err crosses exec: not the rig's DDS sockets
             // (a controller holding them would keep the rig's ports bound after
             // the rig is gone), not its trace files, not its ptys' masters.
             ::execvpe(raw_argv[0], raw_argv.data(), raw_environment.data());
-            err = errno;
+            failure[1] = errno;
         }
-        [[maybe_unused]] const auto written = ::write(report[1], &err, sizeof err);
+        [[maybe_unused]] const auto written = ::write(report[1], failure, sizeof failure);
         ::_exit(127);
     }
     ::close(report[1]);
-    int child_errno = 0;
+    int failure[2] = {0, 0};
     ssize_t got;
-    do got = ::read(report[0], &child_errno, sizeof child_errno);
+    do got = ::read(report[0], failure, sizeof failure);
     while (got < 0 && errno == EINTR);
     ::close(report[0]);
-    if (got == static_cast<ssize_t>(sizeof child_errno)) {
+    if (got == static_cast<ssize_t>(sizeof failure)) {
         int status = 0;
         ::waitpid(pid_, &status, 0);
         pid_ = -1;
-        throw std::runtime_error("cannot start '" + command_line_ + "': " + std::strerror(child_errno));
+        const std::string reason = std::strerror(failure[1]);
+        switch (static_cast<StartStep>(failure[0])) {
+            case StartStep::null_input:
+                throw std::runtime_error("cannot start '" + command_line_ + "': /dev/null: " + reason);
+            case StartStep::log:
+                throw std::runtime_error("cannot start '" + command_line_ + "': cannot open its log '" + log +
+                                         "': " + reason);
+            case StartStep::descriptors:
+                throw std::runtime_error("cannot start '" + command_line_ + "': setting up its file descriptors: " +
+                                         reason);
+            case StartStep::exec:
+                break;
+        }
+        throw std::runtime_error("cannot start '" + command_line_ + "': " + reason);
     }
 }
 
