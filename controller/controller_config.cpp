@@ -127,6 +127,7 @@ ControllerFaults read_faults(const YamlSection& section) {
     faults.lead_scale = section.optional_in_range("lead_scale", faults.lead_scale, Bounds::closed(0.0, 20.0));
     faults.valve_held = section.optional<bool>("valve_held", faults.valve_held);
     faults.stale_fix_reanchor = section.optional<bool>("stale_fix_reanchor", faults.stale_fix_reanchor);
+    faults.boom_height_read_once = section.optional<bool>("boom_height_read_once", faults.boom_height_read_once);
     faults.crash_at_s = section.optional_in_range("crash_at_s", faults.crash_at_s, Bounds::closed(0.0, 86400.0));
     faults.stall_at_s = section.optional_in_range("stall_at_s", faults.stall_at_s, Bounds::closed(0.0, 86400.0));
     static constexpr std::array<std::string_view, 2> kForgeable = {"truth/vehicle", "truth/hydraulics"};
@@ -140,7 +141,7 @@ ControllerFaults read_faults(const YamlSection& section) {
 
 bool ControllerFaults::any() const {
     return never_resume || never_spray || section_chatter_period_s > 0.0 || lead_scale != 1.0 || valve_held ||
-           stale_fix_reanchor || crash_at_s >= 0.0 || stall_at_s >= 0.0 || !read_topic.empty() || !write_topic.empty();
+           stale_fix_reanchor || boom_height_read_once || crash_at_s >= 0.0 || stall_at_s >= 0.0 || !read_topic.empty() || !write_topic.empty();
 }
 
 ControllerConfig parse_controller_config(const YamlSection& section) {

@@ -46,6 +46,9 @@ struct ControllerFaults {
     // re-feeds the last fix as a new one every receiver epoch, and every fix
     // (fresh or stale) re-anchors the odometer (fusion's s_b, Eq. 7).
     bool stale_fix_reanchor = false;
+    // Reads the pull-wire boom-height sensor once, at power-on, and keeps that h
+    // (and so Eq. 6's L4) for the whole run, whatever the push rod does after.
+    bool boom_height_read_once = false;
     double crash_at_s = -1.0;               // >= 0: the process aborts (SIGABRT) at this simulated time
     double stall_at_s = -1.0;               // >= 0: stops answering the clock at this simulated time
     std::string read_topic;                 // reads this topic too, without saying so in its hello (truth/vehicle)

@@ -145,7 +145,10 @@ void SprayController::on_pump_sensor_voltage(double voltage_v, TimeNs now_ns) {
 
 void SprayController::on_boom_height_voltage(double voltage_v, TimeNs /*now_ns*/) {
     const double rise_m = linkage_rise_m_from_voltage(voltage_v, config_.boom_height_span_v, config_.boom_height_range_m);
-    if (!std::isfinite(rise_m) || rise_m == linkage_rise_m_) return;
+    if (!std::isfinite(rise_m)) return;
+    if (config_.faults.boom_height_read_once && boom_height_read_) return;
+    boom_height_read_ = true;
+    if (rise_m == linkage_rise_m_) return;
     linkage_rise_m_ = rise_m;
     locator_.set_linkage_rise_m(rise_m);
 }

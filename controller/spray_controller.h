@@ -152,6 +152,7 @@ private:
     std::optional<double> pump_flow_l_min_;
     TimeNs last_pump_sample_ns_ = 0;
     double linkage_rise_m_;
+    bool boom_height_read_ = false;  // a pull-wire sample has been taken (faults.boom_height_read_once)
 
     msg::SprayPhase phase_ = msg::SPRAY_VALVE_RESET;
     io::ActuatorCommands actuators_{};

@@ -9,7 +9,7 @@ namespace rig::emulators {
 Plant::Plant(const PlantParams& params)
     : params_(params),
       field_(params.origin_lat_deg, params.origin_lon_deg, params.origin_height_m, params.heading_deg),
-      vehicle_(params.route, params.boom, params.start_nozzle_line_along_m),
+      vehicle_(params.route, params.boom, params.start_nozzle_line_along_m, params.boom_lifts),
       wheel_(params.wheel, params.seed) {}
 
 msg::VehicleTruth Plant::truth_at(TimeNs t) const {
@@ -26,8 +26,8 @@ msg::VehicleTruth Plant::truth_at(TimeNs t) const {
     truth.heading_deg(field_.heading_deg());
     truth.speed_m_s(state.speed_m_s);
     truth.nozzle_line_along_m(state.nozzle_line_along_m);
-    truth.l4_m(params_.boom.l4_m());
-    truth.boom_height_m(params_.boom.linkage_rise_m);
+    truth.l4_m(state.l4_m);
+    truth.boom_height_m(state.linkage_rise_m);
     truth.wheel_travel_m(wheel_.wheel_travel_m(state.odometer_distance_m));
     truth.pass_index(static_cast<std::uint16_t>(vehicle_.pass_index_at(ns_to_seconds(t))));
     return truth;

@@ -20,7 +20,8 @@ struct PlantParams {
     double origin_lon_deg = 116.44;
     double origin_height_m = 50.0;
     double heading_deg = 90.0;
-    BoomGeometry boom{};
+    BoomGeometry boom{};  // linkage_rise_m: h at t = 0
+    std::vector<BoomLift> boom_lifts;  // the push rod's moves (none: h stays)
     std::vector<RoutePhase> route;
     double start_nozzle_line_along_m = 0.0;
     LandWheelParams wheel{};
@@ -33,7 +34,7 @@ public:
 
     const FieldFrame& field() const { return field_; }
     const VehiclePlant& vehicle() const { return vehicle_; }
-    const BoomGeometry& boom() const { return params_.boom; }
+    const BoomGeometry& boom() const { return params_.boom; }  // at t = 0; h(t) in truth_at
     const LandWheel& land_wheel() const { return wheel_; }
     // Complete truth at time t (a pure function of t and the seed).
     msg::VehicleTruth truth_at(TimeNs t) const;

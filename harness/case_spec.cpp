@@ -182,8 +182,27 @@ BoomSpec read_boom(const YamlSection& section) {
     boom.l2_m = section.optional_in_range<double>("l2_m", boom.l2_m, Bounds::open_closed(0, 20));
     boom.l3_m = section.optional_in_range<double>("l3_m", boom.l3_m, Bounds::closed(0, 20));
     // The three-point linkage lifts the boom by well under 2 m.
-    boom.linkage_rise_m =
-        section.optional_in_range<double>("linkage_rise_m", boom.linkage_rise_m, Bounds::closed(0, 5));
+    const Bounds rise_bounds = Bounds::closed(0, 5);
+    boom.linkage_rise_m = section.optional_in_range<double>("linkage_rise_m", boom.linkage_rise_m, rise_bounds);
+    const std::vector<YamlSection> lifts = section.list("lifts");
+    if (lifts.size() > kMaxEpisodes) section.fail("lifts", "at most " + std::to_string(kMaxEpisodes) + " items");
+    double push_rod_free_s = 0.0;
+    for (const YamlSection& item : lifts) {
+        BoomLiftSpec lift;
+        lift.at_s = item.required_in_range<double>("at_s", kEventStartBounds);
+        lift.at_location = item.location("at_s");
+        lift.to_m = item.required_in_range<double>("to_m", rise_bounds);
+        lift.to_location = item.location("to_m");
+        // Electric linear actuators move at a few mm/s to tens of mm/s under
+        // load; a hydraulic lift cylinder reaches tenths of a metre per second.
+        lift.rate_m_s = item.required_in_range<double>("rate_m_s", Bounds::closed(0.005, 1));
+        if (lift.at_s < push_rod_free_s) {
+            item.fail("at_s", "starts at " + number_text(lift.at_s) + " s, before the previous lift arrives (" +
+                                  number_text(push_rod_free_s) + " s): one push rod moves one way at a time");
+        }
+        boom.lifts.push_back(lift);
+        push_rod_free_s = lift.at_s + boom.lift_duration_s(boom.lifts.size() - 1);
+    }
     return boom;
 }
 
@@ -618,6 +637,11 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
 
 }  // namespace
 
+double BoomSpec::lift_duration_s(std::size_t index) const {
+    const double from_m = index == 0 ? linkage_rise_m : lifts.at(index - 1).to_m;
+    return std::abs(lifts.at(index).to_m - from_m) / lifts.at(index).rate_m_s;
+}
+
 std::string_view to_string(RunMode mode) { return name_of(kRunModes, mode); }
 std::string_view to_string(Scenario scenario) { return name_of(kScenarios, scenario); }
 std::string_view to_string(GnssWire wire) { return name_of(kGnssWires, wire); }
@@ -892,6 +916,10 @@ void check_case_timeline(const CaseSpec& spec, double case_end_s, double breakpo
     }
     for (const GnssDegraded& degraded : spec.gnss.degraded) {
         check(degraded.at_s, degraded.for_s, degraded.at_location, degraded.for_location, "the degraded episode");
+    }
+    for (std::size_t index = 0; index < spec.boom.lifts.size(); ++index) {
+        const BoomLiftSpec& lift = spec.boom.lifts[index];
+        check(lift.at_s, spec.boom.lift_duration_s(index), lift.at_location, lift.to_location, "the boom lift");
     }
     if (spec.rig_faults) {
         check(spec.rig_faults->master_stall_at_s, spec.rig_faults->master_stall_for_s, spec.rig_faults->at_location,

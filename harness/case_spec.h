@@ -86,11 +86,25 @@ inline constexpr double kMaxEventS = 86'400.0;
 
 // Antenna-to-nozzle geometry of Eq. 6: L4 = L1 + cos(atan(h/L2))*L2 + L3, 1.63 m with these values.
 // Each length [0, 20] m (l2_m (0, 20]: h/L2), linkage rise [0, 5] m.
+// The operator moves the boom during the run (the electric push rod, sec. 2.2.3):
+// from at_s the linkage rise h goes to to_m at rate_m_s (emulators/vehicle_plant.h
+// BoomLift). Each lift starts once the previous one has arrived.
+struct BoomLiftSpec {
+    double at_s = 0.0;      // [0, kMaxEventS], within the case (check_case_timeline)
+    double to_m = 0.0;      // [0, 5], as linkage_rise_m
+    double rate_m_s = 0.0;  // required, [0.005, 1]
+    SourceLocation at_location;
+    SourceLocation to_location;
+};
+
 struct BoomSpec {
     double l1_m = 0.50;
     double l2_m = 0.80;
     double l3_m = 0.45;
-    double linkage_rise_m = 0.50;  // h in Eq. 6
+    double linkage_rise_m = 0.50;  // h in Eq. 6 at t = 0
+    std::vector<BoomLiftSpec> lifts;  // `boom.lifts`, none by default: h stays
+    // How long lift `index` takes from the h the previous one left.
+    double lift_duration_s(std::size_t index) const;
 };
 
 struct BreakpointSpec {

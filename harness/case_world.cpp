@@ -136,6 +136,9 @@ CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed) {
     plant_params.boom =
         emulators::BoomGeometry{spec.boom.l1_m, spec.boom.l2_m, spec.boom.l3_m, spec.boom.linkage_rise_m};
     ScenarioPlan scenario = build_scenario(spec, plant_params.boom);
+    for (const BoomLiftSpec& lift : spec.boom.lifts) {
+        plant_params.boom_lifts.push_back(emulators::BoomLift{lift.at_s, lift.to_m, lift.rate_m_s});
+    }
     plant_params.route = scenario.route;
     plant_params.start_nozzle_line_along_m = scenario.start_along_m;
     plant_params.wheel.slip_pct = spec.encoder.slip_pct;
@@ -144,9 +147,12 @@ CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed) {
     plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
     plant_params.seed = seed;
     emulators::Plant plant(plant_params);
+    const double breakpoint_along_m =
+        scenario.button.empty() ? spec.breakpoint.along_m
+                                : plant.vehicle().state_at(scenario.button.front().at_s).nozzle_line_along_m;
     const double crossing_s = spec.scenario == Scenario::static_flow
                                   ? std::numeric_limits<double>::quiet_NaN()
-                                  : plant.vehicle().time_when_nozzle_line_reaches(spec.breakpoint.along_m,
+                                  : plant.vehicle().time_when_nozzle_line_reaches(breakpoint_along_m,
                                                                                   scenario.approach_starts_s);
     const TimeNs end_ns = seconds_to_ns(plant.vehicle().end_time_s() + 1.0);
     emulators::G970Params gnss = gnss_params(spec, seed, crossing_s);
@@ -154,13 +160,14 @@ CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed) {
     const double grid_from_m = std::min(scenario.start_along_m, spec.vehicle.start_m) - 5.0;
     const double grid_to_m = spec.breakpoint.along_m + spec.vehicle.overrun_m + 5.0;
     emulators::SprayCircuitParams circuit = circuit_params(spec, grid_from_m, grid_to_m);
-    return CaseWorld{std::move(plant), std::move(scenario), std::move(gnss), std::move(circuit), crossing_s, end_ns};
+    return CaseWorld{std::move(plant),   std::move(scenario), std::move(gnss), std::move(circuit),
+                     crossing_s,         breakpoint_along_m,  end_ns};
 }
 
 JudgingPlan plan_judging(const CaseSpec& spec, const CaseWorld& world) {
     JudgingPlan plan;
     plan.scenario = std::string(to_string(spec.scenario));
-    plan.breakpoint_along_m = spec.breakpoint.along_m;
+    plan.breakpoint_along_m = world.breakpoint_along_m;
     plan.field_origin_lat_deg = spec.field.origin.lat_deg;
     plan.field_origin_lon_deg = spec.field.origin.lon_deg;
     plan.field_origin_height_m = spec.field.origin.height_m;

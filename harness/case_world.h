@@ -31,6 +31,10 @@ struct CaseWorld {
     emulators::G970Params gnss;
     emulators::SprayCircuitParams circuit;  // its deposition grid spans all the boom can reach
     double breakpoint_crossing_s = 0.0;     // on the approach; NaN in a static test
+    // Where the spray stopped: the nozzle line when the operator pressed the
+    // button. breakpoint.along_m, unless the boom moved before the button (the
+    // route is the nozzle line's path at the initial h: emulators/vehicle_plant.h).
+    double breakpoint_along_m = 0.0;
     TimeNs end_ns = 0;
 };
 CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed);
