@@ -94,6 +94,7 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
         {"wrong-pulses-per-litre", {"flow_adjust_time_s", "flow_error_pct"}},
         {"wrong-l4", {"breakpoint_store_error_m"}},
         {"stale-fix-through-dropout", {"breakpoint_error_m"}},
+        {"boom-height-read-once", {"breakpoint_error_m"}},
     };
     const std::map<std::string, std::string> errors = {
         {"crashes-mid-case", "node_exited"},
@@ -101,7 +102,7 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
         {"reads-truth-topic", "topic_role_violation"},
         {"forges-truth-topic", "topic_role_violation"},
     };
-    ASSERT_EQ(results.at("cases").size(), broken.size() + errors.size() + 3) << results.dump(2);
+    ASSERT_EQ(results.at("cases").size(), broken.size() + errors.size() + 4) << results.dump(2);
     for (const auto& [name, metrics] : broken) {
         const nlohmann::json* one = find_case(results, name + "-seed1");
         ASSERT_NE(one, nullptr) << name;
@@ -117,7 +118,7 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
         EXPECT_EQ(one->at("error_kind"), kind) << one->dump(2);
     }
     for (const char* control : {"reference-controller-seed1", "reference-controller-identification-seed1",
-                                "reference-controller-calibration-gap-seed1"}) {
+                                "reference-controller-calibration-gap-seed1", "reference-controller-boom-lowered-seed1"}) {
         const nlohmann::json* one = find_case(results, control);
         ASSERT_NE(one, nullptr) << control;
         EXPECT_TRUE(one->at("passed").get<bool>()) << one->dump(2);
@@ -130,6 +131,15 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
     EXPECT_NEAR(find_case(results, "never-resumes-seed1")->at("metrics").at("missed_m").get<double>(), 9.0, 0.1);
     EXPECT_NEAR(find_case(results, "never-sprays-seed1")->at("metrics").at("missed_m").get<double>(), 33.0, 0.1);
     EXPECT_GT(find_case(results, "stale-fix-through-dropout-seed1")->at("metrics").at("breakpoint_error_m").get<double>(), 1.0);
+    // The boom lowered on the approach (h 1.0 -> 0) moves the nozzle line 0.30 m
+    // back from the antenna (Eq. 6: L4 1.45 -> 1.75 m): the controller that kept
+    // its power-on reading declares the breakpoint that much earlier than the
+    // reference controller on the same seed.
+    const auto signed_error_m = [&](const char* name) {
+        return find_case(results, name)->at("metrics").at("breakpoint_error_signed_m").get<double>();
+    };
+    EXPECT_NEAR(signed_error_m("boom-height-read-once-seed1") - signed_error_m("reference-controller-boom-lowered-seed1"),
+                -0.30, 0.05);
     // Role violations name the topic and the participant.
     const std::string reader_error = find_case(results, "reads-truth-topic-seed1")->at("error").get<std::string>();
     EXPECT_NE(reader_error.find("node 'controller': reads truth topic truth/vehicle"), std::string::npos) << reader_error;
