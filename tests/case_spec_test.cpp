@@ -622,6 +622,11 @@ std::string minimal_with(const std::string& section, const std::string& key, con
                 }
                 if (list == "dropouts" || list == "degraded") item["for_s"] = 1;
                 if (list == "degraded") item["sigma_m"] = 0.1;
+                if (list == "lifts") {
+                    item["at_s"] = 1;
+                    item["to_m"] = 0.2;
+                    item["rate_m_s"] = 0.05;
+                }
                 parent[list].push_back(item);
             }
             chain.push_back(parent[list][0]);
@@ -642,15 +647,15 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
         "gnss",       "gnss.noise",  "gnss.dropouts[0]",   "gnss.degraded[0]",       "encoder",
         "hydraulics", "hydraulics.valve", "hydraulics.flow_map", "flow_meter", "pump_sensor",
         "boom_height_sensor",        "deposition",         "static_flow", "wiring",   "timeouts",
-        "realtime",   "rig_faults", "gnss.wire_faults", "board.line_noise"};
+        "realtime",   "rig_faults", "gnss.wire_faults", "board.line_noise", "boom.lifts[0]"};
     const int ranged =
         expect_every_number_bounded(sections, [](const std::string& section, const std::string& key,
                                                  const std::string& value) {
             parse_case(minimal_with(section, key, value), "bounds.yaml");
         });
-    // The sweep found the keys, not an empty list: a case file has 86 numbers
+    // The sweep found the keys, not an empty list: a case file has 89 numbers
     // (a new one with a range changes this count; one without fails above).
-    EXPECT_EQ(ranged, 86);
+    EXPECT_EQ(ranged, 89);
     // Limits are data keys: their values are bounded too.
     for (const char* value : {"1e300", "-1e300"}) {
         EXPECT_THROW(parse_case(std::string(kMinimalCase) + "limits: { overlap_m: " + value + " }\n", "l.yaml"),
@@ -765,6 +770,66 @@ TEST(CaseSpec, EpisodesOutsideTheCasesTimelineAreRefusedAtTheirKey) {
     }
     // A dropout placed before the breakpoint in a static test has nothing to be placed by.
     EXPECT_THROW(check_case_timeline(spec, 60.0, std::nan("")), ConfigError);
+}
+
+// The boom's push-rod moves: read as written, each checked at its key, one
+// move at a time, and held to the case's timeline like the GNSS episodes.
+TEST(CaseSpec, BoomLiftsParseAndAreCheckedAtTheirKeys) {
+    EXPECT_TRUE(parse_case(kMinimalCase, "none.yaml").boom.lifts.empty());
+    const std::string text = std::string(kMinimalCase) + R"(boom:
+  linkage_rise_m: 1.0
+  lifts:
+    - { at_s: 10, to_m: 0.0, rate_m_s: 0.05 }
+    - { at_s: 30, to_m: 0.4, rate_m_s: 0.1 }
+)";
+    const CaseSpec spec = parse_case(text, "lifts.yaml");
+    ASSERT_EQ(spec.boom.lifts.size(), 2u);
+    EXPECT_EQ(spec.boom.lifts[1].at_s, 30.0);
+    EXPECT_EQ(spec.boom.lifts[1].to_m, 0.4);
+    EXPECT_EQ(spec.boom.lifts[1].rate_m_s, 0.1);
+    EXPECT_DOUBLE_EQ(spec.boom.lift_duration_s(0), 20.0);  // 1.0 m down at 50 mm/s
+    EXPECT_DOUBLE_EQ(spec.boom.lift_duration_s(1), 4.0);   // 0.4 m up at 100 mm/s
+
+    struct Broken {
+        const char* legend;
+        std::string text;
+        const char* key_path;
+        const char* message_part;
+    };
+    const std::string head = std::string(kMinimalCase) + "boom:\n  linkage_rise_m: 1.0\n  lifts:\n";
+    const std::vector<Broken> broken = {
+        {"the second starts before the first arrives (10 + 20 s)",
+         head + "    - { at_s: 10, to_m: 0.0, rate_m_s: 0.05 }\n    - { at_s: 29.5, to_m: 0.4, rate_m_s: 0.1 }\n",
+         "boom.lifts[1].at_s", "before the previous lift arrives (30 s)"},
+        {"no rate", head + "    - { at_s: 10, to_m: 0.0 }\n", "boom.lifts[0].rate_m_s", "required key missing"},
+        {"a push rod at 2 m/s", head + "    - { at_s: 10, to_m: 0.0, rate_m_s: 2 }\n", "boom.lifts[0].rate_m_s",
+         "must be <= 1"},
+        {"below the linkage's range", head + "    - { at_s: 10, to_m: -0.1, rate_m_s: 0.05 }\n",
+         "boom.lifts[0].to_m", "must be >= 0"},
+        {"an unknown key", head + "    - { at_s: 10, to_m: 0.0, rate_m_s: 0.05, speed_m_s: 1 }\n",
+         "boom.lifts[0].speed_m_s", "unknown key"},
+    };
+    for (const Broken& one : broken) {
+        SCOPED_TRACE(one.legend);
+        try {
+            parse_case(one.text, "lifts.yaml");
+            ADD_FAILURE() << "accepted";
+        } catch (const ConfigError& error) {
+            EXPECT_EQ(error.key_path(), one.key_path) << error.what();
+            EXPECT_GT(error.line(), 0) << error.what();
+            EXPECT_NE(error.message().find(one.message_part), std::string::npos) << error.what();
+        }
+    }
+
+    // The timeline: a 60 s case holds both moves; in a 25 s case the second starts after the end.
+    EXPECT_NO_THROW(check_case_timeline(spec, 60.0, 40.0));
+    try {
+        check_case_timeline(spec, 25.0, 20.0);
+        ADD_FAILURE() << "accepted a lift after the case's end";
+    } catch (const ConfigError& error) {
+        EXPECT_EQ(error.key_path(), "boom.lifts[1].at_s") << error.what();
+        EXPECT_NE(error.message().find("after the case ends"), std::string::npos) << error.what();
+    }
 }
 
 // Anything but a regular file is refused by what it is, naming the path,

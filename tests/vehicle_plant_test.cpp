@@ -4,6 +4,7 @@
 
 #include <GeographicLib/Geodesic.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -190,6 +191,157 @@ TEST(VehiclePlant, RejectsImpossibleRoutes) {
     const VehiclePlant still({DrivePhase{3.0, 1.0, 0.5}}, BoomGeometry{}, 3.0);
     EXPECT_EQ(still.end_time_s(), 0.0);
     EXPECT_EQ(still.time_when_nozzle_line_reaches(3.0), 0.0);
+}
+
+// --- the boom moving during the run (BoomLift)
+
+// Eq. 6 written out here, apart from the plant's: L4 = L1 + cos(atan(h/L2)) L2 + L3
+// with the paper's 0.5 / 0.8 / 0.45 m, cos(atan(x)) = 1 / sqrt(1 + x^2).
+double eq6_l4_m(double rise_m) { return 0.5 + 0.8 / std::sqrt(1.0 + (rise_m / 0.8) * (rise_m / 0.8)) + 0.45; }
+
+std::vector<RoutePhase> stand_then_approach() {
+    return {StandPhase{2.0}, DrivePhase{0.0, kSixKmH_m_s, 0.5}, StandPhase{5.0}, DrivePhase{10.0, kSixKmH_m_s, 0.5}};
+}
+
+TEST(VehiclePlant, L4FollowsTheLinkageRiseAndTheAntennaTheRoute) {
+    // Up 0.5 -> 1.0 m at 0.1 m/s from 10 s (arrives at 15 s), back down at 30 s (arrives at 35 s).
+    const VehiclePlant moving(stand_then_approach(), BoomGeometry{}, -60.0,
+                              {BoomLift{10.0, 1.0, 0.1}, BoomLift{30.0, 0.5, 0.1}});
+    const VehiclePlant still(stand_then_approach(), BoomGeometry{}, -60.0);
+    for (const double t_s : {0.0, 5.0, 9.99, 10.0, 12.5, 15.0, 20.0, 32.5, 35.0, 38.0, 50.0}) {
+        SCOPED_TRACE(t_s);
+        const VehicleState a = moving.state_at(t_s);
+        const VehicleState b = still.state_at(t_s);
+        // The vehicle drives the same whatever the boom does.
+        EXPECT_EQ(a.antenna_along_m, b.antenna_along_m);
+        EXPECT_EQ(a.speed_m_s, b.speed_m_s);
+        EXPECT_EQ(a.odometer_distance_m, b.odometer_distance_m);
+        EXPECT_NEAR(a.l4_m, eq6_l4_m(a.linkage_rise_m), 1e-12);
+        EXPECT_NEAR(a.antenna_along_m - a.nozzle_line_along_m, a.l4_m, 1e-12);
+        EXPECT_EQ(b.linkage_rise_m, 0.5);
+        EXPECT_EQ(b.nozzle_line_along_m + b.l4_m, b.antenna_along_m);
+    }
+    EXPECT_NEAR(moving.state_at(12.5).linkage_rise_m, 0.75, 1e-12);
+    EXPECT_EQ(moving.state_at(15.0).linkage_rise_m, 1.0);
+    EXPECT_EQ(moving.state_at(20.0).linkage_rise_m, 1.0);
+    EXPECT_NEAR(moving.state_at(32.5).linkage_rise_m, 0.75, 1e-12);
+    // Raised, the nozzles swing 0.179 m towards the antenna (1.628 -> 1.450 m).
+    EXPECT_NEAR(moving.state_at(20.0).nozzle_line_along_m - still.state_at(20.0).nozzle_line_along_m,
+                eq6_l4_m(0.5) - eq6_l4_m(1.0), 1e-12);
+    EXPECT_NEAR(eq6_l4_m(0.5) - eq6_l4_m(1.0), 0.179, 0.001);
+    // Before the first move and once back at the initial h: the route itself, bit for bit.
+    for (const double t_s : {0.0, 9.99, 10.0, 35.0, 38.0, 50.0}) {
+        EXPECT_EQ(moving.state_at(t_s).nozzle_line_along_m, still.state_at(t_s).nozzle_line_along_m) << t_s;
+        EXPECT_EQ(moving.state_at(t_s).l4_m, still.state_at(t_s).l4_m) << t_s;
+    }
+}
+
+// Equal bit for bit, or both NaN ("never").
+bool same_time(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+
+TEST(VehiclePlant, LiftsAfterTheRouteLeaveEveryAnswerBitForBit) {
+    const VehiclePlant still(stand_then_approach(), BoomGeometry{}, -60.0);
+    const VehiclePlant late(stand_then_approach(), BoomGeometry{}, -60.0,
+                            {BoomLift{still.end_time_s() + 1.0, 0.9, 0.05}});
+    for (double t_s = 0.0; t_s <= still.end_time_s(); t_s += 0.37) {
+        EXPECT_EQ(late.state_at(t_s).nozzle_line_along_m, still.state_at(t_s).nozzle_line_along_m) << t_s;
+    }
+    EXPECT_TRUE(std::isfinite(still.time_when_nozzle_line_reaches(4.0, 45.0)));
+    for (const double along_m : {-59.0, -30.0, -0.5, 0.0, 4.0, 10.0}) {
+        EXPECT_TRUE(same_time(late.time_when_nozzle_line_reaches(along_m), still.time_when_nozzle_line_reaches(along_m)))
+            << along_m;
+        EXPECT_TRUE(same_time(late.time_when_nozzle_line_reaches(along_m, 45.0),
+                              still.time_when_nozzle_line_reaches(along_m, 45.0)))
+            << along_m;
+    }
+}
+
+TEST(VehiclePlant, TimeWhenNozzleLineReachesAgreesWithStateAtWhileTheBoomMoves) {
+    // Raised while accelerating and cruising, lowered (h 1.0 -> 0) while cruising
+    // (the vehicle's 1.67 m/s beats the boom's at most 0.385 x 0.1 m/s backwards:
+    // the nozzle line still only goes forward), raised again in the stand at the
+    // breakpoint (41.3-46.3 s), where the nozzle line moves with the vehicle still.
+    const VehiclePlant plant(stand_then_approach(), BoomGeometry{}, -60.0,
+                             {BoomLift{3.0, 1.0, 0.05}, BoomLift{20.0, 0.0, 0.1}, BoomLift{42.0, 1.0, 0.5}});
+    int reached = 0;
+    for (double along_m = -59.5; along_m <= 10.0; along_m += 0.173) {
+        SCOPED_TRACE(along_m);
+        const double t_s = plant.time_when_nozzle_line_reaches(along_m);
+        ASSERT_TRUE(std::isfinite(t_s));
+        ++reached;
+        EXPECT_NEAR(plant.state_at(t_s).nozzle_line_along_m, along_m, 1e-9);
+        // Forward only here, so the first time is where a bisection on state_at finds it.
+        EXPECT_NEAR(t_s, bisect_reach(plant, along_m, 0.0, plant.end_time_s()), 1e-7);
+    }
+    EXPECT_GT(reached, 390);
+    // Between where the lowered boom left the nozzle line at the stop (L4 1.75 m:
+    // 0.12 m short of the route's 0) and where raising it in the stand takes it
+    // (L4 1.45 m: 0.18 m past): reached while the vehicle stands.
+    const double stand_s = plant.time_when_nozzle_line_reaches(0.1, 30.0);
+    EXPECT_GT(stand_s, 42.0);
+    EXPECT_LT(stand_s, 44.0);
+    EXPECT_EQ(plant.state_at(stand_s).speed_m_s, 0.0);
+    EXPECT_NEAR(plant.state_at(stand_s).nozzle_line_along_m, 0.1, 1e-9);
+}
+
+TEST(VehiclePlant, LoweringTheBoomMovesTheNozzleLineBackAtMost0385TimesTheRate) {
+    // Standing at 0 with h 1.0, lowered to 0 at 50 mm/s from 5 s to 25 s.
+    const double rate_m_s = 0.05;
+    const VehiclePlant standing({StandPhase{30.0}}, BoomGeometry{0.5, 0.8, 0.45, 1.0}, 0.0,
+                                {BoomLift{5.0, 0.0, rate_m_s}});
+    EXPECT_NEAR(standing.state_at(30.0).nozzle_line_along_m, eq6_l4_m(1.0) - eq6_l4_m(0.0), 1e-12);  // -0.30 m
+    double fastest_back_m_s = 0.0;
+    for (double t_s = 5.0; t_s < 25.0; t_s += 0.01) {
+        const double step_m = standing.state_at(t_s + 0.01).nozzle_line_along_m - standing.state_at(t_s).nozzle_line_along_m;
+        EXPECT_LE(step_m, 0.0) << t_s;
+        fastest_back_m_s = std::max(fastest_back_m_s, -step_m / 0.01);
+    }
+    // max |dL4/dh| = 2 / (3 sqrt 3), at h = L2 / sqrt 2 (0.57 m), which the move passes.
+    const double bound_m_s = 2.0 / (3.0 * std::sqrt(3.0)) * rate_m_s;
+    EXPECT_LE(fastest_back_m_s, bound_m_s * (1.0 + 1e-6));
+    EXPECT_GT(fastest_back_m_s, bound_m_s * 0.999);
+    // Going back over a spot counts as reaching it (the nozzles pass over it);
+    // a spot ahead is never reached.
+    const double back_s = standing.time_when_nozzle_line_reaches(-0.15);
+    EXPECT_GT(back_s, 5.0);
+    EXPECT_LT(back_s, 25.0);
+    EXPECT_NEAR(standing.state_at(back_s).nozzle_line_along_m, -0.15, 1e-9);
+    EXPECT_TRUE(std::isnan(standing.time_when_nozzle_line_reaches(0.1)));
+
+    // Creeping forward at 2 cm/s while the boom drops at 0.5 m/s (up to 0.19 m/s
+    // back): the nozzle line goes back over -0.1 m, then forward over it again.
+    const VehiclePlant creeping({DrivePhase{1.0, 0.02, 0.5}}, BoomGeometry{0.5, 0.8, 0.45, 1.0}, 0.0,
+                                {BoomLift{1.0, 0.0, 0.5}});
+    const double first_s = creeping.time_when_nozzle_line_reaches(-0.1);
+    EXPECT_GT(first_s, 1.0);
+    EXPECT_LT(first_s, 3.0);
+    EXPECT_NEAR(creeping.state_at(first_s).nozzle_line_along_m, -0.1, 1e-9);
+    for (double t_s = 0.0; t_s < first_s - 1e-3; t_s += 1e-3) {
+        EXPECT_GT(creeping.state_at(t_s).nozzle_line_along_m, -0.1) << t_s;  // it is the first
+    }
+    const double again_s = creeping.time_when_nozzle_line_reaches(-0.1, first_s + 0.01);
+    EXPECT_GT(again_s, 3.0);
+    EXPECT_NEAR(creeping.state_at(again_s).nozzle_line_along_m, -0.1, 1e-9);
+}
+
+TEST(VehiclePlant, RejectsImpossibleLifts) {
+    const auto build = [](BoomGeometry boom, std::vector<BoomLift> lifts) {
+        return VehiclePlant({StandPhase{10.0}}, boom, 0.0, std::move(lifts));
+    };
+    EXPECT_THROW(build(BoomGeometry{}, {BoomLift{-1.0, 0.2, 0.1}}), std::invalid_argument);
+    EXPECT_THROW(build(BoomGeometry{}, {BoomLift{1.0, -0.2, 0.1}}), std::invalid_argument);
+    EXPECT_THROW(build(BoomGeometry{}, {BoomLift{1.0, 0.2, 0.0}}), std::invalid_argument);
+    EXPECT_THROW(build(BoomGeometry{}, {BoomLift{1.0, 0.2, std::nan("")}}), std::invalid_argument);
+    EXPECT_THROW(build(BoomGeometry{}, {BoomLift{1.0, 20.0, 0.1}}), std::invalid_argument);
+    EXPECT_THROW(build(BoomGeometry{0.5, 0.8, 0.45, -0.1}, {BoomLift{1.0, 0.2, 0.1}}), std::invalid_argument);
+    try {
+        // 0.5 -> 0.2 m at 0.1 m/s arrives at 4 s; the next starts at 3.9 s.
+        build(BoomGeometry{}, {BoomLift{1.0, 0.2, 0.1}, BoomLift{3.9, 0.6, 0.1}});
+        FAIL() << "overlapping lifts were accepted";
+    } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find("boom lift 1"), std::string::npos) << error.what();
+    }
+    EXPECT_NO_THROW(build(BoomGeometry{}, {BoomLift{1.0, 0.2, 0.1}, BoomLift{4.0, 0.6, 0.1}}));
 }
 
 // --- field frame
