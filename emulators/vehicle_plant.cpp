@@ -49,15 +49,15 @@ VehiclePlant::Segment VehiclePlant::make_drive(const DrivePhase& drive, double s
 
 VehiclePlant::VehiclePlant(std::vector<RoutePhase> route, BoomGeometry boom, double start_nozzle_line_along_m,
                            std::vector<BoomLift> lifts)
-    : boom_(boom), l4_m_(boom.l4_m()), lifts_(std::move(lifts)), start_nozzle_line_along_m_(start_nozzle_line_along_m) {
-    if (!lifts_.empty() && !(boom.linkage_rise_m >= 0.0 && boom.linkage_rise_m <= kMaxLinkageRiseM)) {
+    : boom_(boom), l4_m_(boom.l4_m()), start_nozzle_line_along_m_(start_nozzle_line_along_m) {
+    if (!lifts.empty() && !(boom.linkage_rise_m >= 0.0 && boom.linkage_rise_m <= kMaxLinkageRiseM)) {
         throw std::invalid_argument("boom lift: the initial linkage rise must be in [0, " +
                                     std::to_string(kMaxLinkageRiseM) + "] m when the boom moves");
     }
     double rise_m = boom.linkage_rise_m;
     double push_rod_free_s = 0.0;
-    for (std::size_t index = 0; index < lifts_.size(); ++index) {
-        const BoomLift& lift = lifts_[index];
+    for (std::size_t index = 0; index < lifts.size(); ++index) {
+        const BoomLift& lift = lifts[index];
         if (!std::isfinite(lift.at_s) || lift.at_s < 0.0) reject_lift(index, "at_s must be finite and >= 0");
         if (!(lift.to_m >= 0.0 && lift.to_m <= kMaxLinkageRiseM)) {
             reject_lift(index, "to_m must be in [0, " + std::to_string(kMaxLinkageRiseM) + "] m");
@@ -285,7 +285,15 @@ double VehiclePlant::time_when_nozzle_line_reaches(double along_m, double after_
     if (!lift_segments_.empty()) {
         for (const Segment& segment : segments_) {
             const double end_s = segment.start_s + segment.duration_s;
-            if (end_s < after_s || segment.duration_s <= 0.0) continue;
+            if (end_s < after_s) continue;
+            if (segment.duration_s <= 0.0) {
+                // A zero-length drive at along_m counts, as without lifts; a reposition is a jump, not a passage.
+                if (segment.kind == Segment::Kind::drive &&
+                    nozzle_line_from_route_m(segment.end_along_m, segment.start_s) == along_m) {
+                    return segment.start_s;
+                }
+                continue;
+            }
             // Cut the segment where either motion changes law: its own speed
             // profile's joints and the push rod's starts and stops.
             std::vector<double> cuts{std::max(segment.start_s, after_s), end_s};

@@ -28,9 +28,9 @@
 // behind it, nozzle(t) = antenna(t) - L4(h(t)) (Eq. 6). Without lifts, or while
 // h is back at h0, the nozzle line is the route position itself (bit for bit).
 // Lifting (h up) swings the nozzles towards the antenna, lowering swings them
-// back: while lowering, the nozzle line can move backwards over the ground
-// (at most 2 / (3 sqrt 3) = 0.385 x the push rod's rate faster than the vehicle
-// drives forward: the largest |dL4/dh| of Eq. 6, at h = L2 / sqrt 2).
+// back, relative to the antenna, at most 2 / (3 sqrt 3) = 0.385 x the push rod's
+// rate (the largest |dL4/dh| of Eq. 6, at h = L2 / sqrt 2): lowered faster than
+// that outruns the vehicle, the nozzle line moves backwards over the ground.
 #include <cstddef>
 #include <variant>
 #include <vector>
@@ -127,7 +127,6 @@ public:
     static constexpr double kMaxLinkageRiseM = 10.0;
     // h of Eq. 6 at t_s (closed form: the lifts are piecewise linear).
     double linkage_rise_m_at(double t_s) const;
-    const std::vector<BoomLift>& lifts() const { return lifts_; }
 
     const BoomGeometry& boom() const { return boom_; }
 
@@ -178,7 +177,6 @@ private:
     BoomGeometry boom_;
     double l4_m_;  // at the initial h
     std::vector<LiftSegment> lift_segments_;
-    std::vector<BoomLift> lifts_;
     double start_nozzle_line_along_m_;
     std::vector<Segment> segments_;
 };

@@ -342,6 +342,9 @@ TEST(VehiclePlant, RejectsImpossibleLifts) {
         EXPECT_NE(std::string(error.what()).find("boom lift 1"), std::string::npos) << error.what();
     }
     EXPECT_NO_THROW(build(BoomGeometry{}, {BoomLift{1.0, 0.2, 0.1}, BoomLift{4.0, 0.6, 0.1}}));
+    // A zero-length drive still counts as being there, as without lifts.
+    const VehiclePlant still({DrivePhase{3.0, 1.0, 0.5}}, BoomGeometry{}, 3.0, {BoomLift{1.0, 0.2, 0.1}});
+    EXPECT_EQ(still.time_when_nozzle_line_reaches(3.0), 0.0);
 }
 
 // --- field frame
