@@ -356,13 +356,18 @@ std::vector<VehicleSample> vehicle_samples(const RecordedTrace& trace) {
     return samples;
 }
 
-std::vector<HydraulicsSample> hydraulics_samples(const RecordedTrace& trace) {
+// The flow judge reads the main flow and the sections; Fig. 11's also the pump
+// and the valve (`with_pump_and_valve`).
+std::vector<HydraulicsSample> hydraulics_samples(const RecordedTrace& trace, bool with_pump_and_valve = false) {
     std::vector<HydraulicsSample> samples;
     for (const RecordedSample& sample : samples_of(trace, topics::kHydraulicsTruth)) {
-        samples.push_back(HydraulicsSample{sample.t_ns, sample.json.at("main_flow_l_min").get<double>(),
-                                           sample.json.at("sections_spraying_mask").get<std::uint16_t>(),
-                                           sample.json.at("pump_flow_l_min").get<double>(),
-                                           sample.json.at("valve_opening_pct").get<double>()});
+        HydraulicsSample hydraulics{sample.t_ns, sample.json.at("main_flow_l_min").get<double>(),
+                                    sample.json.at("sections_spraying_mask").get<std::uint16_t>()};
+        if (with_pump_and_valve) {
+            hydraulics.pump_flow_l_min = sample.json.at("pump_flow_l_min").get<double>();
+            hydraulics.valve_opening_pct = sample.json.at("valve_opening_pct").get<double>();
+        }
+        samples.push_back(hydraulics);
     }
     return samples;
 }
@@ -566,7 +571,9 @@ CaseRun judge_trace(const RecordedTrace& trace) {
             }
             metrics.merge(spray_timing_metrics(commands, hydraulics, trace.landing_edges));
         }
-        if (plan.judge_fig11) metrics.merge(fig11_metrics(hydraulics_samples(trace), plan.flow_window).metrics);
+        if (plan.judge_fig11) {
+            metrics.merge(fig11_metrics(hydraulics_samples(trace, /*with_pump_and_valve=*/true), plan.flow_window).metrics);
+        }
         if (plan.judge_deposition) {
             const DepositionResult deposition = deposition_metrics(trace.dose, plan.deposition, plan.breakpoint_along_m);
             metrics.merge(deposition.metrics);
