@@ -86,6 +86,19 @@ TEST(ValveCalibrationProcedure, APointTakenWhileTheThrottleMovedIsDropped) {
     EXPECT_TRUE(procedure.fit().empty());
 }
 
+TEST(ValveCalibrationProcedure, PointsAtOnePumpFlowGiveNoLineEvenWithNoSpanAsked) {
+    CalibrationRunConfig config;
+    config.openings_pct = {90.0};
+    config.settle_s = 1.0;
+    config.measure_s = 1.0;
+    config.min_span_l_min = 0.0;
+    ValveCalibrationProcedure procedure(config);
+    double opening = 90.0;
+    run(procedure, 0, 30.0, [](TimeNs) { return 40.0; }, &opening);
+    EXPECT_GE(procedure.points().size(), 3u);
+    EXPECT_TRUE(procedure.fit().empty());  // no slope through one pump flow, and no NaN line
+}
+
 TEST(Fig11Metrics, HoldsAtSteadyPumpFlowsGiveALinePerOpening) {
     // Truth every 10 ms: three openings held 5 s each at each of three pump flows.
     std::vector<rig::harness::HydraulicsSample> samples;
