@@ -93,7 +93,8 @@ std::vector<ValveCalibrationProcedure::Line> ValveCalibrationProcedure::fit() co
             sxy += (point->pump_l_min - mean_x) * (point->main_l_min - mean_y);
             syy += (point->main_l_min - mean_y) * (point->main_l_min - mean_y);
         }
-        if (!(sxx > 0.0)) continue;  // every point at one pump flow (min_span_l_min 0): no slope to fit
+        // Every point at one pump flow (min_span_l_min 0): no slope to fit.
+        if (!(line.pump_max_l_min > line.pump_min_l_min) || !(sxx > 0.0)) continue;
         line.line.slope = sxy / sxx;
         line.line.intercept_l_min = mean_y - line.line.slope * mean_x;
         double residual = 0.0;

@@ -405,7 +405,8 @@ Fig11Result fig11_metrics(const std::vector<HydraulicsSample>& hydraulics, const
             sxy += (point.pump_l_min - mean_x) * (point.main_l_min - mean_y);
             syy += (point.main_l_min - mean_y) * (point.main_l_min - mean_y);
         }
-        if (!(sxx > 0.0)) continue;  // every point at one pump flow: no slope to fit
+        // Every point at one pump flow: no slope to fit.
+        if (!(line.pump_max_l_min > line.pump_min_l_min) || !(sxx > 0.0)) continue;
         line.slope = sxy / sxx;
         line.intercept_l_min = mean_y - line.slope * mean_x;
         double residual = 0.0;
