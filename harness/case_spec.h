@@ -173,14 +173,14 @@ struct EncoderSpec {
     double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 
-// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
-// Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
 // The operator moves the throttle: from at_s the pump delivers flow_l_min.
 struct ThrottleStepSpec {
     double at_s = 0.0;                       // [0, 86400], each at least throttle_ramp_s after the one before
     double flow_l_min = 31.1;                // (0, 200]
 };
 
+// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
+// Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
 struct HydraulicsSpec {
     double pump_flow_l_min = 31.1;           // (0, 200], at the start
     std::vector<ThrottleStepSpec> pump_throttle;  // at most 100 steps
