@@ -1,6 +1,7 @@
 #include "controller/controller_config.h"
 
 #include <array>
+#include <cstdlib>
 
 #include "controller/breakpoint_store.h"
 #include "rig/config/yaml_fields.h"
@@ -144,6 +145,44 @@ bool ControllerFaults::any() const {
            stale_fix_reanchor || boom_height_read_once || crash_at_s >= 0.0 || stall_at_s >= 0.0 || !read_topic.empty() || !write_topic.empty();
 }
 
+namespace {
+
+CalibrationRunConfig read_calibration_run(const YamlSection& section) {
+    CalibrationRunConfig run;
+    run.enabled = true;
+    if (section.has("openings_pct")) {
+        const std::vector<std::string> openings = section.string_list("openings_pct");
+        // One per % of opening at most, like a calibration's lines.
+        if (openings.empty() || openings.size() > kMaxCalibrationLines) {
+            section.fail("openings_pct", "must list 1 to " + std::to_string(kMaxCalibrationLines) + " openings");
+        }
+        run.openings_pct.clear();
+        for (std::size_t i = 0; i < openings.size(); ++i) {
+            char* end = nullptr;
+            const double opening = std::strtod(openings[i].c_str(), &end);
+            if (openings[i].empty() || end != openings[i].c_str() + openings[i].size() || !(opening >= 0.0) ||
+                !(opening <= 100.0)) {
+                const std::string shown = openings[i].size() > 20 ? openings[i].substr(0, 20) + "..." : openings[i];
+                throw ConfigError(section.item_location("openings_pct", i),
+                                  "an opening must be a number in [0, 100] %, got '" + shown + "'");
+            }
+            run.openings_pct.push_back(opening);
+        }
+    }
+    // The pipeline settles in tenths of a second and the meter's window is 0.25 s;
+    // a minute per point would take an hour per calibration.
+    run.settle_s = section.optional_in_range("settle_s", run.settle_s, Bounds::closed(0.1, 60.0));
+    run.measure_s = section.optional_in_range("measure_s", run.measure_s, Bounds::closed(0.1, 60.0));
+    run.steady_pump_pct = section.optional_in_range("steady_pump_pct", run.steady_pump_pct, Bounds::open_closed(0.0, 50.0));
+    // A straight line needs two points; R^2 means something from three.
+    run.min_points = section.optional_in_range("min_points", run.min_points, Bounds::closed(2, 1000));
+    run.min_span_l_min = section.optional_in_range("min_span_l_min", run.min_span_l_min, Bounds::closed(0.0, 200.0));
+    section.finish();
+    return run;
+}
+
+}  // namespace
+
 ControllerConfig parse_controller_config(const YamlSection& section) {
     ControllerConfig config;
     // The rig's own keys of the section (harness/case_spec.h kControllerRigKeys):
@@ -204,6 +243,7 @@ ControllerConfig parse_controller_config(const YamlSection& section) {
         section.fail("breakpoint_store_file", problem);
     }
     read_flow_control(section, config);
+    if (section.has("calibration_run")) config.calibration_run = read_calibration_run(section.section("calibration_run"));
     config.faults = read_faults(section.section("faults"));
     section.finish();
     return config;

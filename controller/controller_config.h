@@ -9,6 +9,7 @@
 
 #include "controller/flow_pid.h"
 #include "controller/valve_calibration.h"
+#include "controller/valve_calibration_procedure.h"
 #include "controller/valve_driver.h"
 
 namespace rig {
@@ -119,6 +120,10 @@ struct ControllerConfig {
     double boom_height_span_v = 3.3;
     ValveDriverParams valve{};
     std::vector<CalibratedOpening> calibration = default_calibration();
+    // `calibration_run:` present: while the spray switch is on, the controller
+    // runs the valve calibration of sec. 2.4.2 instead of regulating, and writes
+    // what it measured to its state directory (controller/valve_calibration_procedure.h).
+    CalibrationRunConfig calibration_run{};
     ControllerFaults faults{};  // TEST-ONLY (see ControllerFaults)
 };
 

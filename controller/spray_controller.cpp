@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 
 #include "controller/breakpoint_equations.h"
@@ -18,6 +19,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 SprayController::SprayController(ControllerConfig config, const std::filesystem::path& state_dir)
     : config_(std::move(config)),
+      state_dir_(state_dir),
       store_(state_dir / config_.breakpoint_store_file),
       locator_(config_),
       calibration_(config_.calibration),
@@ -26,6 +28,7 @@ SprayController::SprayController(ControllerConfig config, const std::filesystem:
       flow_meter_(config_.flow_meter_pulses_per_l, config_.flow_window_s),
       linkage_rise_m_(config_.linkage_rise_m) {
     store_.load();  // a corrupt store is an error here, before time starts
+    if (config_.calibration_run.enabled) calibration_run_.emplace(config_.calibration_run);
 }
 
 void SprayController::start(TimeNs now_ns) {
@@ -379,6 +382,35 @@ void SprayController::regulate(TimeNs now_ns) {
     }
 }
 
+void SprayController::calibrate(TimeNs now_ns) {
+    const double opening = calibration_run_->update(now_ns, valve_.idle(), pump_flow_l_min_, flow_meter_.flow_l_min());
+    valve_command_pct_ = opening;
+    command_valve(opening, now_ns);
+}
+
+void SprayController::write_calibration_file() {
+    // Written whole to a temporary name, then renamed: a run stopped mid-write
+    // leaves the last complete calibration, never half of one.
+    const std::filesystem::path file = state_dir_ / config_.calibration_run.output_file;
+    const std::filesystem::path partial = state_dir_ / (config_.calibration_run.output_file + ".partial");
+    {
+        std::ofstream out(partial, std::ios::trunc);
+        out << calibration_run_->yaml();
+        if (!out.flush()) {
+            notices_.push_back("valve calibration: cannot write " + partial.string());
+            return;
+        }
+    }
+    std::error_code error;
+    std::filesystem::rename(partial, file, error);
+    if (error) {
+        notices_.push_back("valve calibration: cannot rename " + partial.string() + ": " + error.message());
+        return;
+    }
+    notices_.push_back("valve calibration: " + std::to_string(calibration_run_->fit().size()) + " line(s) from " +
+                       std::to_string(calibration_run_->points().size()) + " point(s) written to " + file.string());
+}
+
 TimeNs SprayController::update(TimeNs now_ns) {
     // The odometer's predicted instant at the breakpoint (a timer compare).
     on_locator_event(locator_.on_time(now_ns), now_ns);
@@ -391,6 +423,14 @@ TimeNs SprayController::update(TimeNs now_ns) {
             if (!valve_.resetting()) enter(halted_ ? msg::SPRAY_HALTED : msg::SPRAY_IDLE, now_ns);
             break;
         case msg::SPRAY_IDLE:
+            if (calibration_run_) {
+                // Calibrating: the sections open and the procedure, not the PID, drives the valve.
+                if (spray_switch_on_) {
+                    open_sections(now_ns);
+                    enter(msg::SPRAY_REGULATING, now_ns);
+                }
+                break;
+            }
             // TEST-ONLY fault never_resume: once a breakpoint was stored, it never sprays again.
             if (spray_switch_on_ && !halted_ && !(config_.faults.never_resume && stored_count_ > 0)) {
                 start_pre_adjust(now_ns);
@@ -405,6 +445,17 @@ TimeNs SprayController::update(TimeNs now_ns) {
             }
             break;
         case msg::SPRAY_REGULATING:
+            if (calibration_run_) {
+                if (!spray_switch_on_) {
+                    close_sections(now_ns);
+                    calibration_run_->pause();
+                    write_calibration_file();
+                    enter(msg::SPRAY_IDLE, now_ns);
+                } else if (pid_due) {
+                    calibrate(now_ns);
+                }
+                break;
+            }
             if (!spray_switch_on_ || !moving_fast_enough(true)) {
                 // Zero-speed shutoff (or switch off): the valve stays where the PID left it.
                 close_sections(now_ns);

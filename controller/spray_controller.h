@@ -43,6 +43,7 @@
 #include "controller/flow_pid.h"
 #include "controller/flow_rate_meter.h"
 #include "controller/valve_calibration.h"
+#include "controller/valve_calibration_procedure.h"
 #include "controller/valve_driver.h"
 #include "controllerPubSubTypes.h"
 #include "rig/runtime/clock.h"
@@ -113,17 +114,23 @@ private:
     TimeNs apply_section_chatter(TimeNs now_ns);
     TimeNs refeed_stale_fix(TimeNs now_ns);
     void regulate(TimeNs now_ns);
+    // The valve calibration run (config_.calibration_run): one period of it, and
+    // its file written when the switch goes off.
+    void calibrate(TimeNs now_ns);
+    void write_calibration_file();
     bool continuation_open_point_reached(TimeNs now_ns) const;
     // The lead of Eq. 7, v (t2 + t3), at which the continuation opens.
     double continuation_lead_m() const;
 
     ControllerConfig config_;
+    std::filesystem::path state_dir_;
     BreakpointStore store_;
     BreakpointLocator locator_;
     ValveCalibration calibration_;
     ValveDriver valve_;
     FlowPid pid_;
     FlowRateMeter flow_meter_;
+    std::optional<ValveCalibrationProcedure> calibration_run_;  // set when config_.calibration_run.enabled
 
     // GNSS, assembled from GGA (position, quality) and RMC (course).
     std::optional<FixInput> last_fix_;

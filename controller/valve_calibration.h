@@ -17,8 +17,9 @@ struct CalibratedOpening {
     double intercept_l_min = 0.0;
 };
 
-// The lines the reference controller ships with (the same values the rig's plant
-// was derived from; see emulators/flow_map.h for how they follow from the paper).
+// The lines the reference controller ships with: those its calibration run
+// measured on the rig (controller/valve_calibration_procedure.h,
+// cases/fig11-calibration), not the plant's own (emulators/flow_map.h).
 std::vector<CalibratedOpening> default_calibration();
 
 class ValveCalibration {

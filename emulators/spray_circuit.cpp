@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 namespace rig::emulators {
 
@@ -41,6 +42,18 @@ SprayCircuit::SprayCircuit(const Plant& plant, SprayCircuitParams params)
         throw std::invalid_argument("spray circuit: valve and droplet delays must be >= 0");
     }
     if (step_ns_ <= 0) throw std::invalid_argument("spray circuit: step_s must be > 0");
+    if (!(params_.throttle_ramp_s >= 0.0)) throw std::invalid_argument("spray circuit: throttle_ramp_s must be >= 0");
+    for (std::size_t i = 0; i < params_.throttle_steps.size(); ++i) {
+        const ThrottleStep& step = params_.throttle_steps[i];
+        if (!(step.flow_l_min > 0.0) || !std::isfinite(step.flow_l_min) || !std::isfinite(step.at_s)) {
+            throw std::invalid_argument("spray circuit: throttle step " + std::to_string(i) +
+                                        ": flow_l_min must be > 0 and at_s finite");
+        }
+        if (i > 0 && !(step.at_s >= params_.throttle_steps[i - 1].at_s + params_.throttle_ramp_s)) {
+            throw std::invalid_argument("spray circuit: throttle step " + std::to_string(i) +
+                                        ": at_s must come at least throttle_ramp_s after the step before");
+        }
+    }
     nozzle_count_ = total_nozzles(params_.section_nozzles);
     for (int section = 0; section < section_count(); ++section) {
         nozzle_section_.insert(nozzle_section_.end(), params_.section_nozzles[static_cast<std::size_t>(section)],
@@ -53,6 +66,20 @@ SprayCircuit::SprayCircuit(const Plant& plant, SprayCircuitParams params)
                      [centre](int a, int b) { return std::abs(a - centre) < std::abs(b - centre); });
     section_pending_.assign(static_cast<std::size_t>(section_count()), {});
     pump_flow_l_min_ = params_.pump_flow_l_min;
+}
+
+double SprayCircuit::throttle_flow_l_min(double t_s) const {
+    double flow = params_.pump_flow_l_min;
+    for (const ThrottleStep& step : params_.throttle_steps) {
+        if (t_s < step.at_s) break;
+        const double into_s = t_s - step.at_s;
+        if (into_s >= params_.throttle_ramp_s) {
+            flow = step.flow_l_min;
+        } else {
+            flow += (step.flow_l_min - flow) * into_s / params_.throttle_ramp_s;
+        }
+    }
+    return flow;
 }
 
 void SprayCircuit::advance_to(TimeNs t) {
@@ -104,7 +131,7 @@ void SprayCircuit::step_once() {
     }
 
     valve_.step(dt);
-    pump_flow_l_min_ = params_.pump_flow_l_min *
+    pump_flow_l_min_ = throttle_flow_l_min(t_s) *
                        (1.0 + params_.pump_pulsation_pct / 100.0 * std::sin(2.0 * M_PI * params_.pump_pulsation_hz * t_s));
 
     const int open_nozzles = open_nozzle_count();

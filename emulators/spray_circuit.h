@@ -11,9 +11,13 @@
 // from the grid step that contains t.
 //
 // What is modelled, and from where:
-//   pump        constant output set by the throttle (36-81 L/min rated; the
+//   pump        output set by the throttle (36-81 L/min rated; the
 //               calibration ran 31.1-57.3 L/min, sec. 2.4.2) with plunger
-//               pulsation (pulsation_pct at pulsation_hz);
+//               pulsation (pulsation_pct at pulsation_hz); the operator may
+//               move the throttle during a run (throttle_steps: "the throttle
+//               size of the sprayer corresponds linearly to the output flow
+//               rate of the pump", sec. 2.4.2), the flow then ramps to the new
+//               value over throttle_ramp_s (the engine's speed change);
 //   unloading   open: the pump flow returns to the tank, the boom line is dry;
 //   ball valve  emulators/ball_valve.h (11 s travel, backlash, start delay);
 //   flow map    emulators/flow_map.h (Fig. 11 lines, Table 2, drift, bulge);
@@ -44,8 +48,18 @@
 
 namespace rig::emulators {
 
+// The operator sets the throttle so that the pump delivers flow_l_min from at_s on.
+struct ThrottleStep {
+    double at_s = 0.0;
+    double flow_l_min = 31.1;
+};
+
 struct SprayCircuitParams {
-    double pump_flow_l_min = 31.1;
+    double pump_flow_l_min = 31.1;          // at the start
+    std::vector<ThrottleStep> throttle_steps;  // in time order
+    // Assumed (the paper gives no figure): an engine takes about a second to
+    // settle at a new speed.
+    double throttle_ramp_s = 1.0;
     double pump_pulsation_pct = 2.0;
     double pump_pulsation_hz = 27.0;        // 3 plungers at 540 rpm
     BallValveParams valve{};
@@ -102,6 +116,8 @@ public:
 private:
     void step_once();
     int open_nozzle_count() const;
+    // The pump's mean output at t_s (throttle steps and their ramps, no pulsation).
+    double throttle_flow_l_min(double t_s) const;
 
     const Plant& plant_;
     SprayCircuitParams params_;

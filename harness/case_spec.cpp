@@ -32,6 +32,7 @@ constexpr EnumChoice<Scenario> kScenarios[] = {
     {"breakpoint_identification", Scenario::breakpoint_identification},
     {"breakpoint_continuation", Scenario::breakpoint_continuation},
     {"static_flow", Scenario::static_flow},
+    {"valve_calibration", Scenario::valve_calibration},
 };
 constexpr EnumChoice<GnssWire> kGnssWires[] = {
     {"dds", GnssWire::dds},
@@ -316,6 +317,22 @@ HydraulicsSpec read_hydraulics(const YamlSection& section) {
         map.optional_in_range<double>("interpolation_bulge_pct", h.interpolation_bulge_pct, Bounds::closed(-20, 20));
     h.calibration_drift_pct =
         map.optional_in_range<double>("calibration_drift_pct", h.calibration_drift_pct, Bounds::closed(-50, 50));
+    // An engine settles at a new speed in about a second; a minute is a stalled one.
+    h.throttle_ramp_s = section.optional_in_range<double>("throttle_ramp_s", h.throttle_ramp_s, Bounds::closed(0, 60));
+    const std::vector<YamlSection> steps = section.list("pump_throttle");
+    if (steps.size() > 100) section.fail("pump_throttle", "at most 100 throttle steps");
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        ThrottleStepSpec step;
+        step.at_s = steps[i].required_in_range<double>("at_s", Bounds::closed(0, 86400));
+        step.flow_l_min = steps[i].required_in_range<double>("flow_l_min", Bounds::open_closed(0, 200));
+        steps[i].finish();
+        if (i > 0 && !(step.at_s >= h.pump_throttle.back().at_s + h.throttle_ramp_s)) {
+            throw ConfigError(section.item_location("pump_throttle", i),
+                              "at_s must come at least throttle_ramp_s (" + number_text(h.throttle_ramp_s) +
+                                  " s) after the step before (" + number_text(h.pump_throttle.back().at_s) + " s)");
+        }
+        h.pump_throttle.push_back(step);
+    }
     if (section.has("section_nozzles")) {
         h.section_nozzles.clear();
         const std::vector<std::string> counts = section.string_list("section_nozzles");
@@ -571,7 +588,7 @@ void check_bench_wiring(const CaseSpec& spec, const YamlSection& root) {
 // Checks between sections; run after finish(), when every value is real.
 void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                         const std::map<std::string, double>& default_limits) {
-    if (spec.scenario != Scenario::static_flow && !(spec.vehicle.start_m < spec.breakpoint.along_m)) {
+    if (!stands_still(spec.scenario) && !(spec.vehicle.start_m < spec.breakpoint.along_m)) {
         root.section("vehicle").fail("start_m", "must be < breakpoint.along_m (" +
                                                     number_text(spec.breakpoint.along_m) +
                                                     ") so the vehicle approaches the breakpoint, got " +
@@ -585,7 +602,7 @@ void check_cross_fields(const CaseSpec& spec, const YamlSection& root,
                                                 " m strip to judge (vehicle.first_pass_m + vehicle.overrun_m)");
         }
     }
-    if (spec.scenario != Scenario::static_flow) {
+    if (!stands_still(spec.scenario)) {
         // The land wheel's terrain (odometer truth) is drawn for this much ground.
         const double terrain_m = emulators::LandWheelParams{}.terrain_length_m;
         const double driven_m =
@@ -648,8 +665,8 @@ std::string_view to_string(GnssWire wire) { return name_of(kGnssWires, wire); }
 std::string_view to_string(BoardIoWireKind wire) { return name_of(kBoardIoWires, wire); }
 
 bool default_limit_applies(Scenario scenario, const std::string& metric) {
-    const bool identifies = scenario != Scenario::static_flow;
-    const bool sprays = scenario != Scenario::breakpoint_identification;
+    const bool identifies = !stands_still(scenario);
+    const bool sprays = scenario != Scenario::breakpoint_identification && scenario != Scenario::valve_calibration;
     const bool continues = scenario == Scenario::breakpoint_continuation;
     if (metric == "breakpoint_error_m") return identifies;
     if (metric == "flow_adjust_time_s" || metric == "flow_error_pct") return sprays;
@@ -808,7 +825,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.utc_start = *utc_start;
 
     spec.field = read_field(root.required_section("field"));
-    const bool standing = spec.scenario == Scenario::static_flow;
+    const bool standing = stands_still(spec.scenario);
     spec.vehicle = read_vehicle(standing ? root.section("vehicle") : root.required_section("vehicle"), standing);
     spec.boom = read_boom(root.section("boom"));
     spec.breakpoint = read_breakpoint(root.section("breakpoint"));

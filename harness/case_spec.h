@@ -43,7 +43,16 @@ struct BoundaryCaseSpec;
 //                              (Tables 5, 6, Fig. 14, 15).
 //   static_flow                the sprayer stands; the spray switch is turned on
 //                              and off (Tables 1, 2: the static tests of sec. 2.4).
-enum class Scenario { breakpoint_identification, breakpoint_continuation, static_flow };
+//   valve_calibration          the sprayer stands; the spray switch is on from
+//                              static_flow.spray_on_at_s for spray_for_s while the
+//                              operator steps the throttle (hydraulics.pump_throttle)
+//                              and the controller runs its valve calibration (sec.
+//                              2.4.2, Fig. 11); judged on the Fig. 11 lines of truth
+enum class Scenario { breakpoint_identification, breakpoint_continuation, static_flow, valve_calibration };
+// Whether the sprayer stands still through the case (the static tests).
+inline bool stands_still(Scenario scenario) {
+    return scenario == Scenario::static_flow || scenario == Scenario::valve_calibration;
+}
 // NMEA talker id of the emulated receiver: GPS, multi-constellation, BeiDou (two spellings).
 enum class GnssTalker { gp, gn, bd, gb };
 enum class GnssFix { rtk_fixed, rtk_float, dgps, autonomous };
@@ -178,10 +187,18 @@ struct EncoderSpec {
     double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 
+// The operator moves the throttle: from at_s the pump delivers flow_l_min.
+struct ThrottleStepSpec {
+    double at_s = 0.0;                       // [0, 86400], each at least throttle_ramp_s after the one before
+    double flow_l_min = 31.1;                // (0, 200]
+};
+
 // The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
 // Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
 struct HydraulicsSpec {
-    double pump_flow_l_min = 31.1;           // (0, 200]
+    double pump_flow_l_min = 31.1;           // (0, 200], at the start
+    std::vector<ThrottleStepSpec> pump_throttle;  // at most 100 steps
+    double throttle_ramp_s = 1.0;            // [0, 60]; assumed (emulators/spray_circuit.h)
     double pump_pulsation_pct = 2.0;         // [0, 50]
     double pump_pulsation_hz = 27.0;         // > 0
     double pipeline_time_constant_s = 0.38;  // (0, 10]; fitted to Table 2's mean (spray_circuit.h)

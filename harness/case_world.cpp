@@ -17,8 +17,8 @@ namespace {
 //   stops with the nozzle line on it; the operator presses the button; the
 //   sprayer turns at the headland (not simulated: it reappears at start_m) and
 //   approaches the breakpoint again, driving overrun_m past it.
-//   static_flow: the sprayer stands at the breakpoint; the spray switch goes on
-//   at spray_on_at_s for spray_for_s (sec. 2.4's static tests).
+//   static_flow, valve_calibration: the sprayer stands at the breakpoint; the
+//   spray switch goes on at spray_on_at_s for spray_for_s (sec. 2.4's static tests).
 constexpr double kStandAfterButtonS = 1.0;
 constexpr double kStandBeforeApproachS = 2.0;
 constexpr double kStandAfterStaticS = 3.0;
@@ -28,7 +28,7 @@ constexpr double kForeverS = 1e6;
 ScenarioPlan build_scenario(const CaseSpec& spec, const emulators::BoomGeometry& boom) {
     const double bp = spec.breakpoint.along_m;
     ScenarioPlan scenario;
-    if (spec.scenario == Scenario::static_flow) {
+    if (stands_still(spec.scenario)) {
         scenario.start_along_m = bp;
         scenario.route.push_back(emulators::StandPhase{spec.static_flow.spray_on_at_s + spec.static_flow.spray_for_s +
                                                        kStandAfterStaticS});
@@ -58,6 +58,10 @@ emulators::SprayCircuitParams circuit_params(const CaseSpec& spec, double grid_f
     const HydraulicsSpec& h = spec.hydraulics;
     emulators::SprayCircuitParams params;
     params.pump_flow_l_min = h.pump_flow_l_min;
+    for (const ThrottleStepSpec& step : h.pump_throttle) {
+        params.throttle_steps.push_back(emulators::ThrottleStep{step.at_s, step.flow_l_min});
+    }
+    params.throttle_ramp_s = h.throttle_ramp_s;
     params.pump_pulsation_pct = h.pump_pulsation_pct;
     params.pump_pulsation_hz = h.pump_pulsation_hz;
     params.valve = emulators::BallValveParams{h.valve_travel_s, h.valve_motor_start_delay_s, h.valve_backlash_pct,
@@ -150,7 +154,7 @@ CaseWorld build_case_world(const CaseSpec& spec, std::uint64_t seed) {
     const double breakpoint_along_m =
         scenario.button.empty() ? spec.breakpoint.along_m
                                 : plant.vehicle().state_at(scenario.button.front().at_s).nozzle_line_along_m;
-    const double crossing_s = spec.scenario == Scenario::static_flow
+    const double crossing_s = stands_still(spec.scenario)
                                   ? std::numeric_limits<double>::quiet_NaN()
                                   : plant.vehicle().time_when_nozzle_line_reaches(breakpoint_along_m,
                                                                                   scenario.approach_starts_s);
@@ -175,8 +179,14 @@ JudgingPlan plan_judging(const CaseSpec& spec, const CaseWorld& world) {
     plan.limits = effective_limits(spec);
     plan.expect_fail = spec.expect.fail;
     plan.expect_error = spec.expect.error;
-    plan.judge_breakpoint = spec.scenario != Scenario::static_flow;
-    plan.judge_flow = spec.scenario != Scenario::breakpoint_identification;
+    plan.judge_breakpoint = !stands_still(spec.scenario);
+    plan.judge_flow = spec.scenario != Scenario::breakpoint_identification && spec.scenario != Scenario::valve_calibration;
+    plan.judge_fig11 = spec.scenario == Scenario::valve_calibration;
+    if (plan.judge_fig11) {
+        // While the switch is on (the procedure runs; the throttle moves).
+        plan.flow_window.from_ns = seconds_to_ns(spec.static_flow.spray_on_at_s);
+        plan.flow_window.to_ns = seconds_to_ns(spec.static_flow.spray_on_at_s + spec.static_flow.spray_for_s);
+    }
     plan.judge_deposition = spec.scenario == Scenario::breakpoint_continuation;
     const emulators::VehiclePlant& vehicle = world.plant.vehicle();
     // The strip that must be sprayed: the first pass's start to the end of the

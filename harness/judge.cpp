@@ -44,6 +44,9 @@ nlohmann::json to_json(const JudgingPlan& plan) {
                         {"kf11_pulses_per_l", plan.kf11_pulses_per_l},
                         {"kf11_window_s", plan.kf11_window_s}};
     }
+    if (plan.judge_fig11) {
+        json["fig11"] = {{"window_from_ns", plan.flow_window.from_ns}, {"window_to_ns", plan.flow_window.to_ns}};
+    }
     if (plan.judge_deposition) {
         json["deposition"] = {{"nominal_dose_ul_cm2", plan.deposition.nominal_dose_ul_cm2},
                               {"sprayed_fraction", plan.deposition.sprayed_fraction},
@@ -87,6 +90,13 @@ JudgingPlan judging_plan_from_json(const nlohmann::json& json) {
             plan.flow_window.to_ns = at(flow, "window_to_ns", "flow.").get<TimeNs>();
             plan.kf11_pulses_per_l = at(flow, "kf11_pulses_per_l", "flow.").get<double>();
             plan.kf11_window_s = at(flow, "kf11_window_s", "flow.").get<double>();
+        }
+        // Traces from before the valve_calibration scenario have no fig11 section.
+        if (json.contains("fig11")) {
+            const nlohmann::json& fig11 = at(json, "fig11", "");
+            plan.judge_fig11 = true;
+            plan.flow_window.from_ns = at(fig11, "window_from_ns", "fig11.").get<TimeNs>();
+            plan.flow_window.to_ns = at(fig11, "window_to_ns", "fig11.").get<TimeNs>();
         }
         if (plan.judge_deposition) {
             const nlohmann::json& deposition = at(json, "deposition", "");
@@ -346,11 +356,18 @@ std::vector<VehicleSample> vehicle_samples(const RecordedTrace& trace) {
     return samples;
 }
 
-std::vector<HydraulicsSample> hydraulics_samples(const RecordedTrace& trace) {
+// The flow judge reads the main flow and the sections; Fig. 11's also the pump
+// and the valve (`with_pump_and_valve`).
+std::vector<HydraulicsSample> hydraulics_samples(const RecordedTrace& trace, bool with_pump_and_valve = false) {
     std::vector<HydraulicsSample> samples;
     for (const RecordedSample& sample : samples_of(trace, topics::kHydraulicsTruth)) {
-        samples.push_back(HydraulicsSample{sample.t_ns, sample.json.at("main_flow_l_min").get<double>(),
-                                           sample.json.at("sections_spraying_mask").get<std::uint16_t>()});
+        HydraulicsSample hydraulics{sample.t_ns, sample.json.at("main_flow_l_min").get<double>(),
+                                    sample.json.at("sections_spraying_mask").get<std::uint16_t>()};
+        if (with_pump_and_valve) {
+            hydraulics.pump_flow_l_min = sample.json.at("pump_flow_l_min").get<double>();
+            hydraulics.valve_opening_pct = sample.json.at("valve_opening_pct").get<double>();
+        }
+        samples.push_back(hydraulics);
     }
     return samples;
 }
@@ -553,6 +570,9 @@ CaseRun judge_trace(const RecordedTrace& trace) {
                 figures.section_open_command_t_s = ns_to_seconds(*flow.first_open_ns);
             }
             metrics.merge(spray_timing_metrics(commands, hydraulics, trace.landing_edges));
+        }
+        if (plan.judge_fig11) {
+            metrics.merge(fig11_metrics(hydraulics_samples(trace, /*with_pump_and_valve=*/true), plan.flow_window).metrics);
         }
         if (plan.judge_deposition) {
             const DepositionResult deposition = deposition_metrics(trace.dose, plan.deposition, plan.breakpoint_along_m);

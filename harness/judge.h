@@ -26,7 +26,7 @@ namespace rig::harness {
 // `judging`, JSON). Everything here is a number the case or its route gave, never
 // something the controller did.
 struct JudgingPlan {
-    std::string scenario;  // breakpoint_identification | breakpoint_continuation | static_flow
+    std::string scenario;  // breakpoint_identification | breakpoint_continuation | static_flow | valve_calibration
     double breakpoint_along_m = 0.0;
     double field_origin_lat_deg = 0.0;
     double field_origin_lon_deg = 0.0;
@@ -38,6 +38,8 @@ struct JudgingPlan {
     FlowWindow flow_window;
     double kf11_pulses_per_l = 90.0;  // the meter's nameplate k (Eq. 3) for the paper-style readings
     double kf11_window_s = 0.25;
+    // Fig. 11 from truth (valve_calibration), over flow_window (the switch on).
+    bool judge_fig11 = false;
     bool judge_deposition = false;
     DepositionJudging deposition;
     std::map<std::string, double> limits;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <numeric>
 
 namespace rig::harness {
@@ -310,6 +311,127 @@ FlowResult flow_metrics(const std::vector<HydraulicsSample>& hydraulics, const s
         if (const auto error = kf11_signed_error(settled_ns)) {
             metrics.values["flow_error_kf11_settled_signed_pct"] = *error;
         }
+    }
+    return result;
+}
+
+Fig11Result fig11_metrics(const std::vector<HydraulicsSample>& hydraulics, const FlowWindow& window,
+                          const Fig11Judging& judging) {
+    struct Point {
+        double pump_l_min;
+        double main_l_min;
+    };
+    std::map<long, std::vector<Point>> points_by_opening;  // key: opening in 0.1 %
+    // One hold: samples [begin, end) of the window with the sections open and the valve still.
+    std::vector<const HydraulicsSample*> hold;
+    auto close_hold = [&] {
+        if (hold.size() < 2) {
+            hold.clear();
+            return;
+        }
+        const TimeNs end_ns = hold.back()->t_ns;
+        if (end_ns - hold.front()->t_ns >= seconds_to_ns(judging.hold_min_s)) {
+            const TimeNs from_ns = end_ns - seconds_to_ns(judging.measure_s);
+            const TimeNs middle_ns = from_ns + (end_ns - from_ns) / 2;
+            double pump_sum = 0.0, main_sum = 0.0, first_sum = 0.0, second_sum = 0.0;
+            int count = 0, first_count = 0, second_count = 0;
+            for (const HydraulicsSample* sample : hold) {
+                if (sample->t_ns < from_ns) continue;
+                pump_sum += sample->pump_flow_l_min;
+                main_sum += sample->main_flow_l_min;
+                ++count;
+                if (sample->t_ns < middle_ns) {
+                    first_sum += sample->pump_flow_l_min;
+                    ++first_count;
+                } else {
+                    second_sum += sample->pump_flow_l_min;
+                    ++second_count;
+                }
+            }
+            if (count > 0 && first_count > 0 && second_count > 0) {
+                const double pump = pump_sum / count;
+                const double drift = std::abs(first_sum / first_count - second_sum / second_count);
+                if (pump > 0.0 && drift <= judging.steady_pump_pct / 100.0 * pump) {
+                    const long key = std::lround(hold.front()->valve_opening_pct * 10.0);
+                    points_by_opening[key].push_back(Point{pump, main_sum / count});
+                }
+            }
+        }
+        hold.clear();
+    };
+    for (const HydraulicsSample& sample : hydraulics) {
+        if (sample.t_ns < window.from_ns) continue;
+        if (sample.t_ns >= window.to_ns) break;
+        const bool open = sample.sections_spraying_mask != 0;
+        if (!open || (!hold.empty() && std::abs(sample.valve_opening_pct - hold.front()->valve_opening_pct) >
+                                           judging.opening_tolerance_pct)) {
+            close_hold();
+        }
+        if (open) hold.push_back(&sample);
+    }
+    close_hold();
+
+    Fig11Result result;
+    MetricSet& metrics = result.metrics;
+    double main_min = 0.0, main_max = 0.0, pump_min = 0.0, pump_max = 0.0;
+    bool any_point = false;
+    for (const auto& [key, points] : points_by_opening) {
+        Fig11Line line;
+        line.opening_pct = static_cast<double>(key) / 10.0;
+        line.points = static_cast<int>(points.size());
+        double sx = 0.0, sy = 0.0;
+        line.pump_min_l_min = points.front().pump_l_min;
+        line.pump_max_l_min = points.front().pump_l_min;
+        for (const Point& point : points) {
+            sx += point.pump_l_min;
+            sy += point.main_l_min;
+            line.pump_min_l_min = std::min(line.pump_min_l_min, point.pump_l_min);
+            line.pump_max_l_min = std::max(line.pump_max_l_min, point.pump_l_min);
+            main_min = any_point ? std::min(main_min, point.main_l_min) : point.main_l_min;
+            main_max = any_point ? std::max(main_max, point.main_l_min) : point.main_l_min;
+            pump_min = any_point ? std::min(pump_min, point.pump_l_min) : point.pump_l_min;
+            pump_max = any_point ? std::max(pump_max, point.pump_l_min) : point.pump_l_min;
+            any_point = true;
+        }
+        if (line.points < judging.min_points || line.pump_max_l_min - line.pump_min_l_min < judging.min_span_l_min) {
+            continue;
+        }
+        const double n = static_cast<double>(points.size());
+        const double mean_x = sx / n;
+        const double mean_y = sy / n;
+        double sxx = 0.0, sxy = 0.0, syy = 0.0;
+        for (const Point& point : points) {
+            sxx += (point.pump_l_min - mean_x) * (point.pump_l_min - mean_x);
+            sxy += (point.pump_l_min - mean_x) * (point.main_l_min - mean_y);
+            syy += (point.main_l_min - mean_y) * (point.main_l_min - mean_y);
+        }
+        // Every point at one pump flow: no slope to fit.
+        if (!(line.pump_max_l_min > line.pump_min_l_min) || !(sxx > 0.0)) continue;
+        line.slope = sxy / sxx;
+        line.intercept_l_min = mean_y - line.slope * mean_x;
+        double residual = 0.0;
+        for (const Point& point : points) {
+            const double error = point.main_l_min - (line.slope * point.pump_l_min + line.intercept_l_min);
+            residual += error * error;
+        }
+        // A flat line through flat points explains everything there is.
+        line.r2 = syy > 0.0 ? 1.0 - residual / syy : 1.0;
+        result.lines.push_back(line);
+    }
+    metrics.values["fig11_lines_count"] = static_cast<double>(result.lines.size());
+    if (result.lines.empty()) {
+        metrics.not_measured["fig11_unexplained_pct"] =
+            "no valve opening was held at " + std::to_string(judging.min_points) + " steady pump flows spanning " +
+            number_text(judging.min_span_l_min, 1) + " L/min with the sections open";
+    } else {
+        double worst_r2 = 1.0;
+        for (const Fig11Line& line : result.lines) worst_r2 = std::min(worst_r2, line.r2);
+        metrics.values["fig11_unexplained_pct"] = 100.0 * (1.0 - worst_r2);
+    }
+    if (any_point) {
+        metrics.values["fig11_main_flow_min_l_min"] = main_min;
+        metrics.values["fig11_main_flow_max_l_min"] = main_max;
+        metrics.values["fig11_pump_span_l_min"] = pump_max - pump_min;
     }
     return result;
 }

@@ -76,6 +76,8 @@ struct HydraulicsSample {
     TimeNs t_ns = 0;
     double main_flow_l_min = 0.0;         // truth
     std::uint16_t sections_spraying_mask = 0;  // section valves physically open
+    double pump_flow_l_min = 0.0;         // truth, pulsation included
+    double valve_opening_pct = 0.0;       // truth
 };
 
 struct SectionCommand {
@@ -157,6 +159,55 @@ struct FlowResult {
 // not measured too.
 FlowResult flow_metrics(const std::vector<HydraulicsSample>& hydraulics, const std::vector<SectionCommand>& commands,
                         const std::vector<FlowReading>& kf11, const FlowWindow& window, const FlowJudging& judging);
+
+// ---------------------------------------------------------------- Fig. 11
+
+// Seed 000 sec. 2.4.2 / 3.1.2, Fig. 11, from truth: what the valve and the pump
+// did while a controller calibrated (scenario valve_calibration). A *hold* is a
+// stretch of at least hold_min_s in which the sections stay open and the valve
+// does not move (within opening_tolerance_pct); its point is the mean true pump
+// and main flow over its last measure_s (the pipeline has settled by then;
+// the pump's pulsation averages out), kept only if the pump's mean over the
+// first and second half of that span agree within steady_pump_pct (the
+// throttle was not moving). Points group by opening (to 0.1 %); each opening
+// with points at min_points pump flows spanning min_span_l_min gives a line
+// main = slope x pump + intercept by least squares, with its R^2.
+struct Fig11Judging {
+    double hold_min_s = 2.0;
+    double measure_s = 1.0;
+    double opening_tolerance_pct = 0.01;
+    double steady_pump_pct = 0.5;
+    int min_points = 3;
+    double min_span_l_min = 5.0;
+};
+
+struct Fig11Line {
+    double opening_pct = 0.0;
+    double slope = 0.0;
+    double intercept_l_min = 0.0;
+    double r2 = 0.0;
+    int points = 0;
+    double pump_min_l_min = 0.0;
+    double pump_max_l_min = 0.0;
+};
+
+struct Fig11Result {
+    MetricSet metrics;
+    std::vector<Fig11Line> lines;  // by opening
+};
+
+//   fig11_lines_count         openings with a line (the paper: 5)
+//   fig11_unexplained_pct     judged: 100 (1 - R^2) of the worst line: the
+//                             variance of the main flow its line leaves
+//                             unexplained (the paper's worst, 95 %: R^2 0.9525,
+//                             4.75 %); not measured without a line
+//   fig11_main_flow_min_l_min, fig11_main_flow_max_l_min
+//                             the smallest and largest point (the paper's
+//                             "adjustable range", 14.20-38.6 L/min over pump
+//                             flows 31.10-57.30 L/min)
+//   fig11_pump_span_l_min     the pump flows the points span
+Fig11Result fig11_metrics(const std::vector<HydraulicsSample>& hydraulics, const FlowWindow& window,
+                          const Fig11Judging& judging = {});
 
 // Table 1 from truth: the first section-open command -> valves open
 // (section_valve_open_delay_s) -> first droplets land (spray_landing_delay_s).

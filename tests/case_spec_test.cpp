@@ -627,6 +627,10 @@ std::string minimal_with(const std::string& section, const std::string& key, con
                     item["to_m"] = 0.2;
                     item["rate_m_s"] = 0.05;
                 }
+                if (list == "pump_throttle") {
+                    item["at_s"] = 60;
+                    item["flow_l_min"] = 40;
+                }
                 parent[list].push_back(item);
             }
             chain.push_back(parent[list][0]);
@@ -645,7 +649,7 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
     const std::vector<std::string> sections = {
         "",           "field",       "field.origin",       "vehicle",    "boom",       "breakpoint",
         "gnss",       "gnss.noise",  "gnss.dropouts[0]",   "gnss.degraded[0]",       "encoder",
-        "hydraulics", "hydraulics.valve", "hydraulics.flow_map", "flow_meter", "pump_sensor",
+        "hydraulics", "hydraulics.valve", "hydraulics.flow_map", "hydraulics.pump_throttle[0]", "flow_meter", "pump_sensor",
         "boom_height_sensor",        "deposition",         "static_flow", "wiring",   "timeouts",
         "realtime",   "rig_faults", "gnss.wire_faults", "board.line_noise", "boom.lifts[0]"};
     const int ranged =
@@ -653,9 +657,9 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
                                                  const std::string& value) {
             parse_case(minimal_with(section, key, value), "bounds.yaml");
         });
-    // The sweep found the keys, not an empty list: a case file has 89 numbers
+    // The sweep found the keys, not an empty list: a case file has 92 numbers
     // (a new one with a range changes this count; one without fails above).
-    EXPECT_EQ(ranged, 89);
+    EXPECT_EQ(ranged, 92);
     // Limits are data keys: their values are bounded too.
     for (const char* value : {"1e300", "-1e300"}) {
         EXPECT_THROW(parse_case(std::string(kMinimalCase) + "limits: { overlap_m: " + value + " }\n", "l.yaml"),
@@ -665,7 +669,8 @@ TEST(CaseSpec, EveryNumericKeyOfACaseFileHasAPhysicalRange) {
 
 TEST(CaseSpec, EveryNumericKeyOfTheReferenceControllersSectionHasAPhysicalRange) {
     const std::vector<std::string> sections = {"",         "boom",        "odometer",           "pid",  "flow_meter",
-                                               "pump_sensor", "boom_height_sensor", "valve", "valve.calibration[0]"};
+                                               "pump_sensor", "boom_height_sensor", "valve", "valve.calibration[0]",
+                                               "calibration_run"};
     const int ranged = expect_every_number_bounded(sections, [](const std::string& section, const std::string& key,
                                                                 const std::string& value) {
         // (YAML::Node's operator= assigns content; reset() rebinds.)
@@ -687,7 +692,7 @@ TEST(CaseSpec, EveryNumericKeyOfTheReferenceControllersSectionHasAPhysicalRange)
         target[key] = YAML::Load(value);
         controller::parse_controller_config(YamlSection(root, "controller.yaml"));
     });
-    EXPECT_EQ(ranged, 41);  // the section's numbers, all found
+    EXPECT_EQ(ranged, 46);  // the section's numbers, all found
 }
 
 // The store is the one file the controller writes: its name stays inside --state-dir.

@@ -177,22 +177,26 @@ TEST(ValveCalibration, OpeningForInvertsPredictedFlow) {
 }
 
 TEST(ValveCalibration, ReproducesThePaperRanges) {
+    // The shipped lines were measured on the rig (cases/fig11-calibration): the
+    // paper's figures hold to within that measurement (0.02 L/min, 0.02 %).
     const ValveCalibration calibration(default_calibration());
+    constexpr double kFlow = 0.02;
+    constexpr double kOpening = 0.02;
     EXPECT_EQ(calibration.lowest_opening_pct(), 87.0);
     EXPECT_EQ(calibration.highest_opening_pct(), 95.0);
     // Fig. 11: 14.20-38.6 L/min main flow for 31.10-57.30 L/min pump flow.
-    EXPECT_NEAR(calibration.predicted_flow_l_min(87.0, 31.1), 14.2, 1e-9);
-    EXPECT_NEAR(calibration.predicted_flow_l_min(95.0, 57.3), 38.6, 1e-9);
-    EXPECT_NEAR(calibration.opening_for(14.2, 31.1), 87.0, 1e-9);
-    EXPECT_NEAR(calibration.opening_for(38.6, 57.3), 95.0, 1e-9);
+    EXPECT_NEAR(calibration.predicted_flow_l_min(87.0, 31.1), 14.2, kFlow);
+    EXPECT_NEAR(calibration.predicted_flow_l_min(95.0, 57.3), 38.6, kFlow);
+    EXPECT_NEAR(calibration.opening_for(14.2, 31.1), 87.0, kOpening);
+    EXPECT_NEAR(calibration.opening_for(38.6, 57.3), 95.0, kOpening);
     // Table 2's openings for their targets at 31.1 L/min: 16 at 90, 19 at 93, 22 at 94.
-    EXPECT_NEAR(calibration.opening_for(16.0, 31.1), 90.0, 1e-9);
-    EXPECT_NEAR(calibration.opening_for(19.0, 31.1), 93.0, 1e-9);
-    EXPECT_NEAR(calibration.opening_for(22.0, 31.1), 94.0, 1e-9);
+    EXPECT_NEAR(calibration.opening_for(16.0, 31.1), 90.0, kOpening);
+    EXPECT_NEAR(calibration.opening_for(19.0, 31.1), 93.0, kOpening);
+    EXPECT_NEAR(calibration.opening_for(22.0, 31.1), 94.0, kOpening);
     // The field target, 20 L/min (sec. 2.5.2): a third of the way from 93 to 94 %.
-    EXPECT_NEAR(calibration.opening_for(20.0, 31.1), 93.0 + 1.0 / 3.0, 1e-9);
+    EXPECT_NEAR(calibration.opening_for(20.0, 31.1), 93.0 + 1.0 / 3.0, kOpening);
     // Between calibrated openings it interpolates linearly: 91.5 % -> 17.5 L/min.
-    EXPECT_NEAR(calibration.predicted_flow_l_min(91.5, 31.1), 17.5, 1e-9);
+    EXPECT_NEAR(calibration.predicted_flow_l_min(91.5, 31.1), 17.5, kFlow);
     // A more powerful pump needs less opening for the same target.
     EXPECT_LT(calibration.opening_for(20.0, 57.3), calibration.opening_for(20.0, 31.1));
     // Always a real opening.
