@@ -121,8 +121,10 @@ struct ControllerConfig {
     ValveDriverParams valve{};
     std::vector<CalibratedOpening> calibration = default_calibration();
     // `calibration_run:` present: while the spray switch is on, the controller
-    // runs the valve calibration of sec. 2.4.2 instead of regulating, and writes
-    // what it measured to its state directory (controller/valve_calibration_procedure.h).
+    // runs the valve calibration of sec. 2.4.2 instead of regulating (its phase
+    // reads REGULATING, sections open), and when the switch goes off writes what
+    // it measured to its state directory (controller/valve_calibration_procedure.h).
+    // A run that ends with the switch on writes nothing.
     CalibrationRunConfig calibration_run{};
     ControllerFaults faults{};  // TEST-ONLY (see ControllerFaults)
 };

@@ -22,7 +22,9 @@
 //                (ValveCalibration::opening_for), sections closed until the
 //                valve is there and the sprayer moves (zero-speed shutoff);
 //   REGULATING   sections open, unloading closed; once the measured flow has
-//                settled, the PID of Eq. 2 every period trims the opening;
+//                settled, the PID of Eq. 2 every period trims the opening
+//                (with `calibration_run`, the valve calibration of sec. 2.4.2
+//                drives the valve instead: valve_calibration_procedure.h);
 //   HALTED       the breakpoint button stored a breakpoint: spraying stops
 //                until the continuation;
 //   APPROACH     the sprayer approaches the stored breakpoint: valve reset,
