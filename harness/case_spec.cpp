@@ -294,8 +294,9 @@ EncoderSpec read_encoder(const YamlSection& section) {
 
 HydraulicsSpec read_hydraulics(const YamlSection& section) {
     HydraulicsSpec h;
-    // Boom-sprayer pumps: tens to ~200 L/min.
-    h.pump_flow_l_min = section.optional_in_range<double>("pump_flow_l_min", h.pump_flow_l_min, Bounds::open_closed(0, 200));
+    // Boom-sprayer pumps: tens to ~200 L/min (at the start, and at each throttle step below).
+    const Bounds pump_flow_bounds = Bounds::open_closed(0, 200);
+    h.pump_flow_l_min = section.optional_in_range<double>("pump_flow_l_min", h.pump_flow_l_min, pump_flow_bounds);
     h.pump_pulsation_pct =
         section.optional_in_range<double>("pump_pulsation_pct", h.pump_pulsation_pct, Bounds::closed(0, 50));
     // Plunger strokes: ~500 rpm x 3 plungers = 27 Hz; 1-500 Hz covers any pump.
@@ -320,16 +321,16 @@ HydraulicsSpec read_hydraulics(const YamlSection& section) {
     // An engine settles at a new speed in about a second; a minute is a stalled one.
     h.throttle_ramp_s = section.optional_in_range<double>("throttle_ramp_s", h.throttle_ramp_s, Bounds::closed(0, 60));
     const std::vector<YamlSection> steps = section.list("pump_throttle");
-    if (steps.size() > 100) section.fail("pump_throttle", "at most 100 throttle steps");
-    for (std::size_t i = 0; i < steps.size(); ++i) {
+    if (steps.size() > kMaxEpisodes) section.fail("pump_throttle", "at most " + std::to_string(kMaxEpisodes) + " items");
+    for (const YamlSection& item : steps) {
         ThrottleStepSpec step;
-        step.at_s = steps[i].required_in_range<double>("at_s", Bounds::closed(0, 86400));
-        step.flow_l_min = steps[i].required_in_range<double>("flow_l_min", Bounds::open_closed(0, 200));
-        steps[i].finish();
-        if (i > 0 && !(step.at_s >= h.pump_throttle.back().at_s + h.throttle_ramp_s)) {
-            throw ConfigError(section.item_location("pump_throttle", i),
-                              "at_s must come at least throttle_ramp_s (" + number_text(h.throttle_ramp_s) +
-                                  " s) after the step before (" + number_text(h.pump_throttle.back().at_s) + " s)");
+        step.at_s = item.required_in_range<double>("at_s", kEventStartBounds);
+        step.flow_l_min = item.required_in_range<double>("flow_l_min", pump_flow_bounds);
+        item.finish();  // a missing at_s is said as missing, not as out of order
+        if (!h.pump_throttle.empty() && !(step.at_s >= h.pump_throttle.back().at_s + h.throttle_ramp_s)) {
+            item.fail("at_s", "starts at " + number_text(step.at_s) + " s, before the previous step's ramp ends (" +
+                                  number_text(h.pump_throttle.back().at_s + h.throttle_ramp_s) +
+                                  " s): one throttle moves one way at a time");
         }
         h.pump_throttle.push_back(step);
     }

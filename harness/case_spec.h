@@ -189,15 +189,15 @@ struct EncoderSpec {
 
 // The operator moves the throttle: from at_s the pump delivers flow_l_min.
 struct ThrottleStepSpec {
-    double at_s = 0.0;                       // [0, 86400], each at least throttle_ramp_s after the one before
-    double flow_l_min = 31.1;                // (0, 200]
+    double at_s = 0.0;                       // [0, kMaxEventS], each at least throttle_ramp_s after the one before
+    double flow_l_min = 31.1;                // (0, 200], as pump_flow_l_min
 };
 
 // The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
 // Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
 struct HydraulicsSpec {
     double pump_flow_l_min = 31.1;           // (0, 200], at the start
-    std::vector<ThrottleStepSpec> pump_throttle;  // at most 100 steps
+    std::vector<ThrottleStepSpec> pump_throttle;  // at most 1000 steps
     double throttle_ramp_s = 1.0;            // [0, 60]; assumed (emulators/spray_circuit.h)
     double pump_pulsation_pct = 2.0;         // [0, 50]
     double pump_pulsation_hz = 27.0;         // > 0

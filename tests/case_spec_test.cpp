@@ -837,6 +837,45 @@ TEST(CaseSpec, BoomLiftsParseAndAreCheckedAtTheirKeys) {
     }
 }
 
+// The operator's throttle steps (Fig. 11's pump flows): read as written, each
+// checked at its key, one ramp at a time.
+TEST(CaseSpec, PumpThrottleStepsParseAndAreCheckedAtTheirKeys) {
+    EXPECT_TRUE(parse_case(kMinimalCase, "none.yaml").hydraulics.pump_throttle.empty());
+    const std::string head = std::string(kMinimalCase) + "hydraulics:\n  throttle_ramp_s: 2\n  pump_throttle:\n";
+    const CaseSpec spec = parse_case(head + "    - { at_s: 10, flow_l_min: 44.2 }\n    - { at_s: 12, flow_l_min: 57.3 }\n",
+                                     "throttle.yaml");
+    ASSERT_EQ(spec.hydraulics.pump_throttle.size(), 2u);
+    EXPECT_EQ(spec.hydraulics.pump_throttle[1].at_s, 12.0);
+    EXPECT_EQ(spec.hydraulics.pump_throttle[1].flow_l_min, 57.3);
+    EXPECT_EQ(spec.hydraulics.throttle_ramp_s, 2.0);
+
+    struct Broken {
+        const char* legend;
+        std::string text;
+        const char* key_path;
+        const char* message_part;
+    };
+    const std::vector<Broken> broken = {
+        {"the second starts inside the first's 2 s ramp",
+         head + "    - { at_s: 10, flow_l_min: 44.2 }\n    - { at_s: 11.5, flow_l_min: 57.3 }\n",
+         "hydraulics.pump_throttle[1].at_s", "before the previous step's ramp ends (12 s)"},
+        {"no flow", head + "    - { at_s: 10 }\n", "hydraulics.pump_throttle[0].flow_l_min", "required key missing"},
+        {"a pump of 500 L/min", head + "    - { at_s: 10, flow_l_min: 500 }\n", "hydraulics.pump_throttle[0].flow_l_min",
+         "must be <= 200"},
+    };
+    for (const Broken& one : broken) {
+        SCOPED_TRACE(one.legend);
+        try {
+            parse_case(one.text, "throttle.yaml");
+            ADD_FAILURE() << "accepted";
+        } catch (const ConfigError& error) {
+            EXPECT_EQ(error.key_path(), one.key_path) << error.what();
+            EXPECT_GT(error.line(), 0) << error.what();
+            EXPECT_NE(error.message().find(one.message_part), std::string::npos) << error.what();
+        }
+    }
+}
+
 // Anything but a regular file is refused by what it is, naming the path,
 // without opening a device or waiting on a FIFO.
 TEST(CaseSpec, SpecialFilesGivenAsCaseFilesAreRefusedByType) {
