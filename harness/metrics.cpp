@@ -419,6 +419,8 @@ Fig11Result fig11_metrics(const std::vector<HydraulicsSample>& hydraulics, const
         result.lines.push_back(line);
     }
     metrics.values["fig11_lines_count"] = static_cast<double>(result.lines.size());
+    metrics.values["fig11_lines_missing_count"] =
+        static_cast<double>(std::max(0, judging.required_lines - static_cast<int>(result.lines.size())));
     if (result.lines.empty()) {
         metrics.not_measured["fig11_unexplained_pct"] =
             "no valve opening was held at " + std::to_string(judging.min_points) + " steady pump flows spanning " +

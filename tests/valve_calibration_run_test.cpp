@@ -116,6 +116,7 @@ TEST(Fig11Metrics, HoldsAtSteadyPumpFlowsGiveALinePerOpening) {
     EXPECT_NEAR(result.lines[2].slope, 0.36, 1e-6);
     EXPECT_NEAR(result.lines[2].intercept_l_min, 2.0, 1e-4);
     EXPECT_EQ(result.metrics.values.at("fig11_lines_count"), 3.0);
+    EXPECT_EQ(result.metrics.values.at("fig11_lines_missing_count"), 2.0);  // of the paper's five
     EXPECT_LT(result.metrics.values.at("fig11_unexplained_pct"), 1e-6);
     EXPECT_NEAR(result.metrics.values.at("fig11_pump_span_l_min"), 26.2, 1e-9);
     // The +-0.01 ripple over an odd count of samples leaves 1e-4 in the mean.
@@ -161,5 +162,6 @@ TEST(ValveCalibrationRun, TheShippedCalibrationIsTheOneMeasuredOnTheRig) {
     const nlohmann::json results = nlohmann::json::parse(rig::testing::read_all(out / "results.json"));
     const nlohmann::json& metrics = results.at("cases").at(0).at("metrics");
     EXPECT_EQ(metrics.at("fig11_lines_count").get<double>(), 5.0);
+    EXPECT_EQ(metrics.at("fig11_lines_missing_count").get<double>(), 0.0);
     EXPECT_LT(metrics.at("fig11_unexplained_pct").get<double>(), 4.75);
 }
