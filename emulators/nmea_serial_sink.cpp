@@ -7,7 +7,7 @@ namespace rig::emulators {
 namespace {
 
 // "$GPGGA,..." shortened for error messages, with CR and LF made visible.
-std::string quoted(std::string_view sentence) {
+std::string quoted_sentence(std::string_view sentence) {
     constexpr std::size_t kShown = 40;
     std::string shown;
     for (char c : sentence.substr(0, kShown)) {
@@ -46,7 +46,7 @@ TimeNs NmeaSerialSink::wire_time_ns(std::size_t bytes) const { return rig::wire_
 
 TimeNs NmeaSerialSink::write_sentence(std::string_view sentence) {
     if (const std::string error = framing_error(sentence); !error.empty()) {
-        throw std::invalid_argument("NMEA sentence " + quoted(sentence) + " not written to " + port_.path() + ": " +
+        throw std::invalid_argument("NMEA sentence " + quoted_sentence(sentence) + " not written to " + port_.path() + ": " +
                                     error);
     }
     port_.write_all(sentence, write_timeout_);
@@ -60,7 +60,7 @@ TimeNs NmeaSerialSink::write_epoch(std::span<const std::string> sentences) {
         if (const std::string error = framing_error(sentences[i]); !error.empty()) {
             throw std::invalid_argument("NMEA epoch not written to " + port_.path() + ": sentence " +
                                         std::to_string(i + 1) + " of " + std::to_string(sentences.size()) + " " +
-                                        quoted(sentences[i]) + ": " + error);
+                                        quoted_sentence(sentences[i]) + ": " + error);
         }
     }
     std::string epoch;

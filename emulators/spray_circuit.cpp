@@ -37,6 +37,12 @@ SprayCircuit::SprayCircuit(const Plant& plant, SprayCircuitParams params)
     if (!(params_.pipeline_time_constant_s > 0.0)) {
         throw std::invalid_argument("spray circuit: pipeline_time_constant_s must be > 0");
     }
+    if (!(params_.pipeline_air_l >= 0.0) || !std::isfinite(params_.pipeline_air_l)) {
+        throw std::invalid_argument("spray circuit: pipeline_air_l must be >= 0");
+    }
+    if (!(params_.nozzle_rated_flow_l_min > 0.0) || !(params_.nozzle_rated_pressure_mpa > 0.0)) {
+        throw std::invalid_argument("spray circuit: nozzle_rated_flow_l_min and nozzle_rated_pressure_mpa must be > 0");
+    }
     if (!(params_.section_valve_open_s >= 0.0) || !(params_.section_valve_close_s >= 0.0) ||
         !(params_.droplet_fall_s >= 0.0)) {
         throw std::invalid_argument("spray circuit: valve and droplet delays must be >= 0");
@@ -114,6 +120,21 @@ int SprayCircuit::open_nozzle_count() const {
     return open;
 }
 
+double SprayCircuit::pipeline_lag_s(double main_flow_l_min, int open_nozzles) const {
+    if (params_.pipeline_air_l == 0.0 || open_nozzles <= 0 || !(main_flow_l_min > 0.0)) {
+        return params_.pipeline_time_constant_s;
+    }
+    constexpr double kAtmosphereMpa = 0.101325;
+    const double per_nozzle = main_flow_l_min / open_nozzles;
+    const double ratio = per_nozzle / params_.nozzle_rated_flow_l_min;
+    const double gauge_mpa = params_.nozzle_rated_pressure_mpa * ratio * ratio;
+    const double absolute_mpa = gauge_mpa + kAtmosphereMpa;
+    const double flow_l_s = main_flow_l_min / 60.0;
+    // R C = (2 P_g / Q) (V P_atm / P^2): litres over litres per second, pressures cancel.
+    return params_.pipeline_time_constant_s +
+           2.0 * params_.pipeline_air_l * kAtmosphereMpa * gauge_mpa / (absolute_mpa * absolute_mpa * flow_l_s);
+}
+
 void SprayCircuit::step_once() {
     const TimeNs now = steps_done_ * step_ns_;
     const double dt = params_.step_s;
@@ -141,7 +162,8 @@ void SprayCircuit::step_once() {
     } else {
         const double settled = flow_map_.main_flow_l_min(valve_.opening_pct(), pump_flow_l_min_) * open_nozzles /
                                nozzle_count_;
-        main_flow_l_min_ += (settled - main_flow_l_min_) * (1.0 - std::exp(-dt / params_.pipeline_time_constant_s));
+        const double lag_s = pipeline_lag_s(settled, open_nozzles);
+        main_flow_l_min_ += (settled - main_flow_l_min_) * (1.0 - std::exp(-dt / lag_s));
     }
     const double volume_l = main_flow_l_min_ / 60.0 * dt;
     main_volume_l_ += volume_l;

@@ -305,6 +305,13 @@ HydraulicsSpec read_hydraulics(const YamlSection& section) {
     // A hose fills in tenths of a second; 10 ms is a pipe with no volume.
     h.pipeline_time_constant_s = section.optional_in_range<double>(
         "pipeline_time_constant_s", h.pipeline_time_constant_s, Bounds::closed(0.01, 10));
+    // A 12-36 m boom holds a few litres in all; 5 L of air is a boom run dry.
+    h.pipeline_air_l = section.optional_in_range<double>("pipeline_air_l", h.pipeline_air_l, Bounds::closed(0, 5));
+    // Flat fans are rated 0.2-5 L/min at 0.2-0.5 MPa (ISO 10625); sprayer pumps stop near 2 MPa.
+    h.nozzle_rated_flow_l_min = section.optional_in_range<double>("nozzle_rated_flow_l_min",
+                                                                  h.nozzle_rated_flow_l_min, Bounds::open_closed(0, 20));
+    h.nozzle_rated_pressure_mpa = section.optional_in_range<double>(
+        "nozzle_rated_pressure_mpa", h.nozzle_rated_pressure_mpa, Bounds::open_closed(0, 2));
     const YamlSection valve = section.section("valve");
     // Motorised ball valves turn in 2-30 s (the paper's 11 s); 0.1 s is a solenoid.
     h.valve_travel_s = valve.optional_in_range<double>("travel_s", h.valve_travel_s, Bounds::closed(0.1, 120));

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "harness/board_spec.h"
+#include "emulators/spray_circuit.h"
 #include "harness/realtime_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
@@ -190,30 +191,37 @@ struct EncoderSpec {
 // The operator moves the throttle: from at_s the pump delivers flow_l_min.
 struct ThrottleStepSpec {
     double at_s = 0.0;                       // [0, kMaxEventS], each at least throttle_ramp_s after the one before
-    double flow_l_min = 31.1;                // (0, 200], as pump_flow_l_min
+    double flow_l_min = 0.0;                 // required, (0, 200], as pump_flow_l_min
 };
 
-// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h); defaults from seed 000.
-// Ranges are in read_hydraulics() (case_spec.cpp), each with its physical reason.
+// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h). Each
+// default is the plant's own (emulators::SprayCircuitParams and the structs it
+// holds), where the value is declared once with its unit and provenance (paper,
+// fit or assumed); this struct only names the keys. Ranges are in
+// read_hydraulics() (case_spec.cpp), each with its physical reason.
+inline const emulators::SprayCircuitParams kCircuitDefaults{};
 struct HydraulicsSpec {
-    double pump_flow_l_min = 31.1;           // (0, 200], at the start
-    std::vector<ThrottleStepSpec> pump_throttle;  // at most 1000 steps
-    double throttle_ramp_s = 1.0;            // [0, 60]; assumed (emulators/spray_circuit.h)
-    double pump_pulsation_pct = 2.0;         // [0, 50]
-    double pump_pulsation_hz = 27.0;         // > 0
-    double pipeline_time_constant_s = 0.38;  // (0, 10]; fitted to Table 2's mean (spray_circuit.h)
-    double valve_travel_s = 11.0;            // sec. 3.1.2: closed -> open in 11 s
-    double valve_backlash_pct = 0.3;
-    double valve_motor_start_delay_s = 0.02;
-    double valve_initial_opening_pct = 85.0;
-    double interpolation_bulge_pct = 2.0;
-    double calibration_drift_pct = 1.0;
-    std::vector<int> section_nozzles = {8, 6, 8};   // 22 nozzles
-    double boom_width_m = 12.2;
-    double section_valve_open_s = 0.200;     // Table 1 t3
-    double section_valve_close_s = 0.200;
-    double droplet_fall_s = 0.067;           // Table 1 t5
-    double min_nozzle_flow_l_min = 0.64;
+    double pump_flow_l_min = kCircuitDefaults.pump_flow_l_min;   // (0, 200], at the start
+    std::vector<ThrottleStepSpec> pump_throttle;                   // at most 1000 steps
+    double throttle_ramp_s = kCircuitDefaults.throttle_ramp_s;   // [0, 60]
+    double pump_pulsation_pct = kCircuitDefaults.pump_pulsation_pct;  // [0, 50]
+    double pump_pulsation_hz = kCircuitDefaults.pump_pulsation_hz;    // [1, 500]
+    double pipeline_time_constant_s = kCircuitDefaults.pipeline_time_constant_s;  // [0.01, 10]: a fit
+    double pipeline_air_l = kCircuitDefaults.pipeline_air_l;                      // [0, 5]: a fit
+    double nozzle_rated_flow_l_min = kCircuitDefaults.nozzle_rated_flow_l_min;    // (0, 20]
+    double nozzle_rated_pressure_mpa = kCircuitDefaults.nozzle_rated_pressure_mpa;  // (0, 2]
+    double valve_travel_s = kCircuitDefaults.valve.travel_s;                      // sec. 3.1.2: 11 s
+    double valve_backlash_pct = kCircuitDefaults.valve.backlash_pct;
+    double valve_motor_start_delay_s = kCircuitDefaults.valve.motor_start_delay_s;
+    double valve_initial_opening_pct = kCircuitDefaults.valve.initial_opening_pct;
+    double interpolation_bulge_pct = kCircuitDefaults.flow_map.interpolation_bulge_pct;
+    double calibration_drift_pct = kCircuitDefaults.flow_map.calibration_drift_pct;
+    std::vector<int> section_nozzles = kCircuitDefaults.section_nozzles;  // 22 nozzles
+    double boom_width_m = kCircuitDefaults.boom_width_m;
+    double section_valve_open_s = kCircuitDefaults.section_valve_open_s;   // Table 1 t3
+    double section_valve_close_s = kCircuitDefaults.section_valve_close_s;
+    double droplet_fall_s = kCircuitDefaults.droplet_fall_s;               // Table 1 t5
+    double min_nozzle_flow_l_min = kCircuitDefaults.min_nozzle_flow_l_min;
 };
 
 // Ranges of this and the sensors below: case_spec.cpp, with their reasons.

@@ -69,6 +69,9 @@ emulators::SprayCircuitParams circuit_params(const CaseSpec& spec, double grid_f
     params.flow_map.interpolation_bulge_pct = h.interpolation_bulge_pct;
     params.flow_map.calibration_drift_pct = h.calibration_drift_pct;
     params.pipeline_time_constant_s = h.pipeline_time_constant_s;
+    params.pipeline_air_l = h.pipeline_air_l;
+    params.nozzle_rated_flow_l_min = h.nozzle_rated_flow_l_min;
+    params.nozzle_rated_pressure_mpa = h.nozzle_rated_pressure_mpa;
     params.section_nozzles = h.section_nozzles;
     params.boom_width_m = h.boom_width_m;
     params.section_valve_open_s = h.section_valve_open_s;

@@ -107,8 +107,11 @@ constexpr double kMaxTrimDriveS = 0.3;
 constexpr double kSpeedWindowS = 0.25;
 constexpr double kMovingMS = 0.05;
 // Sections open this far before the breakpoint on top of the valves' delay, so
-// that nothing after it is missed (the overlap limit is 3.3 m).
-constexpr double kOpenMarginM = 0.4;
+// that nothing after it is missed (the overlap limit is 3.3 m): the flow must
+// be at half its dose by then, and a boom takes tenths of a second to fill
+// (Table 2: 1.1-1.7 s to settle). 0.4 m missed 5 cm at 6 km/h once the rig's
+// boom held air; 1.0 m is 0.6 s at 6 km/h.
+constexpr double kOpenMarginM = 1.0;
 // The approach counts only once the sprayer has been this far from the stored
 // point (it stands on it when the button is pressed).
 constexpr double kArmDistanceM = 2.0;

@@ -178,10 +178,13 @@ TEST(ValveCalibration, OpeningForInvertsPredictedFlow) {
 
 TEST(ValveCalibration, ReproducesThePaperRanges) {
     // The shipped lines were measured on the rig (cases/fig11-calibration): the
-    // paper's figures hold to within that measurement (0.02 L/min, 0.02 %).
+    // paper's figures hold to within that measurement: 0.02 L/min, and 0.05 %
+    // of opening (0.6 L/min per % between 87 and 90 % at 31.1 L/min). What is
+    // left is the procedure's 2 s settle against the boom's air, which at
+    // 14 L/min is 0.6 s of lag: a hold is measured 1-3 % of its step short.
     const ValveCalibration calibration(default_calibration());
     constexpr double kFlow = 0.02;
-    constexpr double kOpening = 0.02;
+    constexpr double kOpening = 0.05;
     EXPECT_EQ(calibration.lowest_opening_pct(), 87.0);
     EXPECT_EQ(calibration.highest_opening_pct(), 95.0);
     // Fig. 11: 14.20-38.6 L/min main flow for 31.10-57.30 L/min pump flow.

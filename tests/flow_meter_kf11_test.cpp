@@ -45,6 +45,7 @@ struct MeterRig {
         params.flow_map.calibration_drift_pct = 0.0;
         params.valve.initial_opening_pct = opening_pct;
         params.pipeline_time_constant_s = 0.25;  // the flow is steady to well under 1e-4 by 3 s
+        params.pipeline_air_l = 0.0;
         return params;
     }
 

@@ -304,6 +304,7 @@ SprayCircuitParams quiet_circuit(double opening_pct) {
     params.flow_map = calibrated_truth();
     params.valve.initial_opening_pct = opening_pct;
     params.pipeline_time_constant_s = 0.25;  // the numbers worked by hand below use this lag
+    params.pipeline_air_l = 0.0;             // and no air: one constant lag at every flow
     return params;
 }
 
@@ -436,6 +437,42 @@ TEST(SprayCircuit, PipelineLagReaches63PercentAfterOneTimeConstant) {
     circuit.advance_to(4 * kS);
     EXPECT_NEAR(circuit.main_flow_l_min(), 25.5, 1e-3);
     EXPECT_EQ(circuit.valve_opening_pct(), 95.0);  // no relay: the ball did not move
+}
+
+// Air in the boom (pipeline_air_l) adds its R C to the lag. Worked by hand for
+// 0.13 L and 22 IDK 120-03 nozzles at 20 L/min: 0.909 L/min a nozzle is
+// 0.3 MPa x (0.909 / 1.2)^2 = 0.1722 MPa gauge, 0.2735 MPa absolute; R C =
+// 2 x 0.13 L x 0.101325 x 0.1722 / (0.2735^2 x 0.3333 L/s) = 0.1819 s.
+TEST(SprayCircuit, AirInTheBoomSlowsALowFlowMoreThanAHighOne) {
+    StaticRig plant_without_air(quiet_circuit(95.0));
+    EXPECT_DOUBLE_EQ(plant_without_air.circuit.pipeline_lag_s(20.0, 22), 0.25);
+    EXPECT_DOUBLE_EQ(plant_without_air.circuit.pipeline_lag_s(5.0, 22), 0.25);
+
+    SprayCircuitParams params = quiet_circuit(95.0);
+    params.pipeline_time_constant_s = 0.30;
+    params.pipeline_air_l = 0.13;
+    StaticRig rig(params);
+    EXPECT_NEAR(rig.circuit.pipeline_lag_s(20.0, 22), 0.30 + 0.1819, 5e-4);
+    // The gas cushion is stiffer at higher pressure: the lag falls as the flow rises
+    // (Table 2's trend), and through fewer nozzles the same flow is at a higher pressure.
+    EXPECT_GT(rig.circuit.pipeline_lag_s(15.0, 22), rig.circuit.pipeline_lag_s(20.0, 22));
+    EXPECT_GT(rig.circuit.pipeline_lag_s(20.0, 22), rig.circuit.pipeline_lag_s(27.0, 22));
+    EXPECT_LT(rig.circuit.pipeline_lag_s(20.0, 8), rig.circuit.pipeline_lag_s(20.0, 22));
+    // No flow, no resistance to speak of: the lag is the line's own.
+    EXPECT_DOUBLE_EQ(rig.circuit.pipeline_lag_s(0.0, 22), 0.30);
+
+    // And the flow follows it: 63 % of the settled 25.5 L/min after one lag.
+    SprayCircuit& circuit = rig.circuit;
+    const double lag_s = circuit.pipeline_lag_s(25.5, 22);
+    circuit.set_unloading_open(false);
+    circuit.advance_to(1 * kS);
+    circuit.set_sections_commanded(0b111);
+    circuit.advance_to(1200 * kMs);
+    circuit.advance_to(1200 * kMs + static_cast<rig::TimeNs>(std::llround(lag_s * 1e3)) * kMs);
+    EXPECT_NEAR(circuit.main_flow_l_min(), 25.5 * (1.0 - std::exp(-1.0)), 0.05);
+
+    params.pipeline_air_l = -0.1;
+    EXPECT_THROW(StaticRig{params}, std::invalid_argument);
 }
 
 TEST(SprayCircuit, FlowSplitsOverOpenSectionsAndOnlyTheirNozzlesSpray) {
