@@ -1,0 +1,114 @@
+#pragma once
+// Seed 001's boom cameras (Sec. 1.1: two SY002HD cameras about 1.30 m apart,
+// 1.0 m above the boom, pitched about 25 deg forward, three nozzles each) as
+// renderers: an RGB frame of the ground the camera sees, from the crop truth
+// (emulators/field2d/crop_cover_map.h) through the camera's true intrinsics,
+// lens distortion and mounting (rig/camera/pinhole_camera.h) at the live boom
+// height. No DDS: a plain class the harness or a test drives.
+//
+// Each pixel's colour is the soil / plant mix of its footprint (n x n samples
+// of the crop truth inside the pixel), times the lighting and colour cast,
+// plus seeded noise per channel, clipped to 0-255. The boom and nozzles are
+// not drawn: they sit below the ROIs in the image (Eq. 1-4's row ~660 against
+// the ROIs' 330-590 with the defaults) and nothing measures them in a working
+// frame; the calibration scene is separate.
+//
+// Named faults, ArduPilot SITL style (each off at its default):
+//   pitch_offset_deg  the camera knocked off the pitch it was calibrated at
+//   blur_radius_px    a dirty lens: box blur of this radius (kernel 2r + 1)
+//   colour_cast       a low sun: per-channel gains on top of the lighting
+//   dead              black_frame (a sensor that delivers zeros) or no_frame
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "emulators/field2d/crop_cover_map.h"
+#include "emulators/field2d/vec2.h"
+#include "rig/camera/pinhole_camera.h"
+#include "rig/camera/rgb_image.h"
+
+namespace rig::emulators::vision {
+
+struct ChannelGains {
+    double red = 1.0;    // [0, 4]
+    double green = 1.0;  // [0, 4]
+    double blue = 1.0;   // [0, 4]
+};
+
+enum class DeadCamera { none, black_frame, no_frame };
+
+struct CameraFaults {
+    double pitch_offset_deg = 0.0;  // [-30, 30] deg, added to the true pitch (the controller keeps its calibration)
+    int blur_radius_px = 0;         // [0, 50] px
+    ChannelGains colour_cast;       // low sun: e.g. 1.35 / 1.0 / 0.65 (assumed: warm, blue-poor light)
+    DeadCamera dead = DeadCamera::none;
+};
+
+struct CameraEmulatorParams {
+    rig::camera::CameraModel camera;  // the camera's truth
+    // Colours under the reference light (assumed: a dry yellow-brown loess
+    // soil, ExG = 2G - R - B = -4; a seedling-wheat green, ExG = 152).
+    rig::camera::Rgb soil_rgb{128, 102, 80};
+    rig::camera::Rgb plant_rgb{64, 128, 40};
+    rig::camera::Rgb sky_rgb{170, 190, 215};  // pixels whose ray misses the ground (only with large pitch)
+    double noise_sd_dn = 6.0;        // [0, 50] DN per channel (assumed: a small CMOS sensor in daylight)
+    double lighting_gain = 1.0;      // [0, 4]: overall light (overcast < 1 < bright sun)
+    ChannelGains lighting_cast;      // [0, 4] each: the light's colour (white at 1 / 1 / 1)
+    int samples_per_axis = 2;        // [1, 8]: a pixel's footprint sampled n x n (mixed pixels at leaf edges)
+    double frame_rate_hz = 30.0;     // (0, 120]; S7 assumed; the renderer does not use it, the harness paces frames by it
+    CameraFaults faults;
+};
+
+// Throws std::invalid_argument "<where>.<field>: <what>".
+void validate(const CameraEmulatorParams& params, const std::string& where);
+
+// Where the boom is (plant truth, e.g. from field2d::SprayerTruth): the ground
+// point under the boom centre, the heading the boom faces, the boom height.
+struct BoomPose {
+    rig::field2d::Vec2 boom_centre_ground;
+    double heading_deg = 0.0;     // compass, the travel direction
+    double boom_height_m = 0.5;   // (0, 5]; Sec. 5.1: 0.5 m
+};
+
+class CameraEmulator {
+public:
+    // `stream` tells apart the noise of cameras sharing a seed (0 left, 1 right).
+    // Throws std::invalid_argument for bad parameters.
+    CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, std::uint64_t stream, std::string name = "camera");
+
+    // The frame number `frame_index` (its noise is drawn from it) of the
+    // ground at `pose`; nullopt for a dead camera that delivers no frame.
+    // Throws std::invalid_argument for a bad boom height.
+    std::optional<rig::camera::RgbImage> render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                std::uint64_t frame_index) const;
+
+    // The ground point (local east/north) the centre of pixel (u, v) sees with
+    // the camera as it truly is (faults included); nullopt if it sees no ground.
+    std::optional<rig::field2d::Vec2> ground_seen(const BoomPose& pose, double u, double v) const;
+
+    // The camera as it truly is: its parameters with the pitch fault applied.
+    const rig::camera::PinholeCamera& true_camera() const { return camera_; }
+    const CameraEmulatorParams& params() const { return params_; }
+    const std::string& name() const { return name_; }
+
+private:
+    CameraEmulatorParams params_;
+    std::uint64_t noise_key_;
+    std::string name_;
+    rig::camera::PinholeCamera camera_;
+    // Undistorted normalised rays at the pixel corners, (width + 1) x (height + 1):
+    // a pixel's footprint is the ground between its four corners' rays.
+    std::vector<Eigen::Vector2d> corner_rays_;
+    std::vector<std::uint8_t> corner_ray_valid_;
+};
+
+// Sec. 1.1's two cameras (left at -0.65 m, right at +0.65 m) with every other
+// parameter at its default.
+CameraEmulatorParams seed001_camera_params(bool right_camera);
+
+// A box blur of radius r on each channel (kernel 2r + 1, edges clamped),
+// separable: two passes of running sums.
+void box_blur(rig::camera::RgbImage& image, int radius_px);
+
+}  // namespace rig::emulators::vision
