@@ -101,6 +101,42 @@ std::optional<Vec2> CameraEmulator::ground_seen(const BoomPose& pose, double u, 
 
 std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                std::uint64_t frame_index) const {
+    return render_scene(crop, pose, nullptr, frame_index);
+}
+
+std::optional<RgbImage> CameraEmulator::render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                           const CalibrationBoards& boards, std::uint64_t frame_index) const {
+    const std::string where = name_ + ".calibration_boards";
+    require(within(boards.boom_board_length_m, 1e-3, 5.0), where, "boom_board_length_m", boards.boom_board_length_m, "[0.001, 5] m");
+    require(within(boards.boom_board_width_m, 1e-3, 1.0), where, "boom_board_width_m", boards.boom_board_width_m, "[0.001, 1] m");
+    require(within(boards.boom_board_right_m, -10.0, 10.0), where, "boom_board_right_m", boards.boom_board_right_m, "[-10, 10] m");
+    require(within(boards.nozzle_board_length_m, 1e-3, 1.0), where, "nozzle_board_length_m", boards.nozzle_board_length_m, "[0.001, 1] m");
+    require(within(boards.nozzle_board_width_m, 1e-3, 1.0), where, "nozzle_board_width_m", boards.nozzle_board_width_m, "[0.001, 1] m");
+    require(within(boards.nozzle_board_ahead_m, -2.0, 2.0), where, "nozzle_board_ahead_m", boards.nozzle_board_ahead_m, "[-2, 2] m");
+    for (const double x : boards.nozzle_right_m) require(within(x, -10.0, 10.0), where, "nozzle_right_m[]", x, "[-10, 10] m");
+    return render_scene(crop, pose, &boards, frame_index);
+}
+
+namespace {
+
+// The board (if any) at a boom-plane point, as its colour.
+std::optional<Rgb> board_at(const CalibrationBoards& boards, double x, double y) {
+    if (std::abs(x - boards.boom_board_right_m) <= 0.5 * boards.boom_board_length_m && std::abs(y) <= 0.5 * boards.boom_board_width_m) {
+        return boards.green;
+    }
+    for (const double nozzle_x : boards.nozzle_right_m) {
+        if (std::abs(x - nozzle_x) <= 0.5 * boards.nozzle_board_width_m &&
+            std::abs(y - boards.nozzle_board_ahead_m) <= 0.5 * boards.nozzle_board_length_m) {
+            return boards.red;
+        }
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                     const CalibrationBoards* boards, std::uint64_t frame_index) const {
     if (!within(pose.boom_height_m, 1e-9, 5.0)) {
         std::ostringstream message;
         message << name_ << ": boom height " << pose.boom_height_m << " m is outside (0, 5] m";
@@ -114,12 +150,14 @@ std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap&
     if (faults.dead == DeadCamera::black_frame) return image;
 
     // Each corner ray met with the ground (z = -h in the boom frame), as
-    // east/north offsets from the boom centre's ground point.
+    // east/north offsets from the boom centre's ground point, and (for the
+    // calibration boards) with the boom plane z = 0, in boom-frame x, y.
     const Eigen::Matrix3d& axes = camera_.axes_in_boom();
     const Eigen::Vector3d& position = camera_.position_in_boom();
     const Vec2 right_axis = rig::field2d::right_of(pose.heading_deg);
     const Vec2 forward_axis = rig::field2d::forward_of(pose.heading_deg);
     std::vector<Vec2> corner_ground(corner_rays_.size());
+    std::vector<Vec2> corner_boom_plane(boards != nullptr ? corner_rays_.size() : 0);
     std::vector<std::uint8_t> corner_hits(corner_rays_.size(), 0);
     const double drop = -pose.boom_height_m - position.z();
     for (std::size_t i = 0; i < corner_rays_.size(); ++i) {
@@ -130,6 +168,10 @@ std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap&
         const double x = position.x() + scale * direction.x();
         const double y = position.y() + scale * direction.y();
         corner_ground[i] = x * right_axis + y * forward_axis;
+        if (boards != nullptr) {
+            const double to_boom_plane = -position.z() / direction.z();
+            corner_boom_plane[i] = Vec2{position.x() + to_boom_plane * direction.x(), position.y() + to_boom_plane * direction.y()};
+        }
         corner_hits[i] = 1;
     }
 
@@ -145,6 +187,14 @@ std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap&
     const double noise_sd = params_.noise_sd_dn;
     const std::size_t stride = static_cast<std::size_t>(width) + 1U;
     const std::uint64_t frame_key = rig::field2d::hash_finalise(noise_key_ ^ rig::field2d::hash_finalise(frame_index));
+    // Bilinear between a pixel's four corners: its footprint on a plane is
+    // nearly a parallelogram.
+    auto inside_pixel = [](const std::vector<Vec2>& corners, std::size_t i00, std::size_t i10, std::size_t i01, std::size_t i11,
+                           double fx, double fy) {
+        const Vec2 top = corners[i00] + fx * (corners[i10] - corners[i00]);
+        const Vec2 bottom = corners[i01] + fx * (corners[i11] - corners[i01]);
+        return top + fy * (bottom - top);
+    };
 
     for (int v = 0; v < height; ++v) {
         for (int u = 0; u < width; ++u) {
@@ -156,23 +206,29 @@ std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap&
             double g = 0.0;
             double b = 0.0;
             if (corner_hits[i00] && corner_hits[i10] && corner_hits[i01] && corner_hits[i11]) {
-                int plants = 0;
                 for (int sy = 0; sy < n; ++sy) {
                     const double fy = (sy + 0.5) / n;
                     for (int sx = 0; sx < n; ++sx) {
                         const double fx = (sx + 0.5) / n;
-                        // Bilinear between the four corners: the footprint of a
-                        // pixel is nearly a parallelogram on the ground.
-                        const Vec2 top = corner_ground[i00] + fx * (corner_ground[i10] - corner_ground[i00]);
-                        const Vec2 bottom = corner_ground[i01] + fx * (corner_ground[i11] - corner_ground[i01]);
-                        const Vec2 offset = top + fy * (bottom - top);
-                        if (crop.is_plant(pose.boom_centre_ground + offset)) ++plants;
+                        Rgb seen = soil;
+                        std::optional<Rgb> board;
+                        if (boards != nullptr) {
+                            const Vec2 on_boom_plane = inside_pixel(corner_boom_plane, i00, i10, i01, i11, fx, fy);
+                            board = board_at(*boards, on_boom_plane.east_m, on_boom_plane.north_m);
+                        }
+                        if (board) {
+                            seen = *board;  // the boards are nearer than the ground
+                        } else if (crop.is_plant(pose.boom_centre_ground + inside_pixel(corner_ground, i00, i10, i01, i11, fx, fy))) {
+                            seen = plant;
+                        }
+                        r += seen.r;
+                        g += seen.g;
+                        b += seen.b;
                     }
                 }
-                const double plant_share = plants * per_sample;
-                r = (soil.r + plant_share * (plant.r - soil.r)) * red_gain;
-                g = (soil.g + plant_share * (plant.g - soil.g)) * green_gain;
-                b = (soil.b + plant_share * (plant.b - soil.b)) * blue_gain;
+                r *= per_sample * red_gain;
+                g *= per_sample * green_gain;
+                b *= per_sample * blue_gain;
             } else {
                 r = sky.r * red_gain;
                 g = sky.g * green_gain;

@@ -63,6 +63,25 @@ struct CameraEmulatorParams {
 // Throws std::invalid_argument "<where>.<field>: <what>".
 void validate(const CameraEmulatorParams& params, const std::string& where);
 
+// Sec. 2.2.1's calibration scene (Fig. 5, 6): a green board on the boom and a
+// red board over each nozzle, all in the boom plane, seen over the ground.
+// The paper gives the boards' sizes; where they sit is assumed: the green
+// board centred on the boom line (so the line fitted along it is the boom's),
+// each red board lengthwise along the travel direction centred over its
+// nozzle's line and clear of the green board (so the two fitted lines cross
+// at the nozzle).
+struct CalibrationBoards {
+    double boom_board_length_m = 0.300;    // along the boom; Sec. 2.2.1
+    double boom_board_width_m = 0.090;     // Sec. 2.2.1
+    double boom_board_right_m = 0.0;       // its centre, m right of the boom centre (a camera's view: its own x)
+    double nozzle_board_length_m = 0.190;  // along travel; Sec. 2.2.1
+    double nozzle_board_width_m = 0.050;   // Sec. 2.2.1
+    double nozzle_board_ahead_m = 0.150;   // centre ahead of the boom line (assumed: 10 mm clear of the green board)
+    std::vector<double> nozzle_right_m;    // one board per nozzle, m right of the boom centre
+    rig::camera::Rgb green{40, 150, 60};   // assumed board colours
+    rig::camera::Rgb red{190, 40, 40};
+};
+
 // Where the boom is (plant truth, e.g. from field2d::SprayerTruth): the ground
 // point under the boom centre, the heading the boom faces, the boom height.
 struct BoomPose {
@@ -83,6 +102,11 @@ public:
     std::optional<rig::camera::RgbImage> render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                 std::uint64_t frame_index) const;
 
+    // The calibration scene over the ground at `pose` (the boards ride with the
+    // boom); faults apply as to any frame. Throws std::invalid_argument for bad boards.
+    std::optional<rig::camera::RgbImage> render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                            const CalibrationBoards& boards, std::uint64_t frame_index) const;
+
     // The ground point (local east/north) the centre of pixel (u, v) sees with
     // the camera as it truly is (faults included); nullopt if it sees no ground.
     std::optional<rig::field2d::Vec2> ground_seen(const BoomPose& pose, double u, double v) const;
@@ -93,6 +117,8 @@ public:
     const std::string& name() const { return name_; }
 
 private:
+    std::optional<rig::camera::RgbImage> render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                      const CalibrationBoards* boards, std::uint64_t frame_index) const;
     CameraEmulatorParams params_;
     std::uint64_t noise_key_;
     std::string name_;
