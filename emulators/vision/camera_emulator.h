@@ -11,7 +11,7 @@
 // plus seeded noise per channel, clipped to 0-255. The boom and nozzles are
 // not drawn: they sit below the ROIs in the image (Eq. 1-4's row ~660 against
 // the ROIs' 330-590 with the defaults) and nothing measures them in a working
-// frame; the calibration scene is separate.
+// frame; render_calibration() draws Sec. 2.2.1's boards.
 //
 // Named faults, ArduPilot SITL style (each off at its default):
 //   pitch_offset_deg  the camera knocked off the pitch it was calibrated at
