@@ -4,6 +4,7 @@
 //   cmake -S . -B build -DRIG_BUILD_BENCHMARKS=ON && cmake --build build -j2 --target vision_bench
 //   build/bin/vision_bench                     ms per frame: rendered (emulator), measured (controller)
 //   build/bin/vision_bench --density-survey    measured - true D per ROI, per cover class and fault
+//   build/bin/vision_bench --frames DIR        PNGs of the left camera's frames with the ROIs drawn
 //
 // Frames: 1280 x 720, 2 x 2 samples per pixel, the default fields; each
 // benchmark iteration renders the next frame of a boom driving north at
@@ -22,6 +23,7 @@
 #include "controller/boundary/vision/nozzle_vision.h"
 #include "emulators/field2d/crop_cover_map.h"
 #include "emulators/vision/camera_emulator.h"
+#include "rig/camera/png_file.h"
 
 namespace {
 
@@ -148,11 +150,62 @@ int density_survey() {
     return 0;
 }
 
+// The left camera's frames of a field whose cover changes along travel
+// (bare, sparse, normal in 2 m bands), healthy and with each fault, the
+// controller's ROIs drawn in magenta with the measured D beside the true D;
+// and its calibration frame.
+int write_frames(const std::string& directory) {
+    CropCoverParams params;
+    params.default_cover = CoverClass::normal;
+    params.patches.push_back({rig::field2d::Polygon({{-5, -1}, {5, -1}, {5, 2}, {-5, 2}}, "bare"), CoverClass::bare});
+    params.patches.push_back({rig::field2d::Polygon({{-5, 2}, {5, 2}, {5, 4}, {-5, 4}}, "sparse"), CoverClass::sparse});
+    const CropCoverMap crop(params, 1);
+    const auto config = seed001_vision_cameras(BoundaryControllerConfig{})[0];
+    const CameraVision vision(config, VisionParams{});
+    std::vector<std::pair<std::string, CameraEmulatorParams>> cameras;
+    cameras.emplace_back("healthy", rig::emulators::vision::seed001_camera_params(false));
+    cameras.emplace_back("pitch_plus5", cameras[0].second);
+    cameras.back().second.faults.pitch_offset_deg = 5.0;
+    cameras.emplace_back("blur4", cameras[0].second);
+    cameras.back().second.faults.blur_radius_px = 4;
+    cameras.emplace_back("low_sun", cameras[0].second);
+    cameras.back().second.faults.colour_cast = {1.35, 1.0, 0.65};
+    for (const auto& [name, params_of_camera] : cameras) {
+        const CameraEmulator camera(params_of_camera, 1, 0, "left");
+        for (const double north : {0.0, 2.0, 4.0, 1.6}) {
+            const BoomPose pose{{0.0, north}, 0.0, 0.5};
+            auto frame = camera.render(crop, pose, 0);
+            const FrameDensities result = vision.measure(&*frame, 0.5);
+            std::printf("%-12s boom at %.1f m:", name.c_str(), north);
+            for (const auto& nozzle : result.nozzles) {
+                const double x = (nozzle.nozzle - 2.5) * 0.5;
+                auto at = [&](double right, double ahead) { return rig::field2d::body_to_field(pose.boom_centre_ground, pose.heading_deg, right, ahead); };
+                const double truth = crop.cover_fraction({at(x - 0.3, 0.2), at(x + 0.3, 0.2), at(x + 0.3, 0.6), at(x - 0.3, 0.6)});
+                std::printf("  nozzle %d D %.3f (true %.3f)", nozzle.nozzle, nozzle.density, truth);
+                rig::camera::draw_quad(*frame, nozzle.roi.image_px, rig::camera::Rgb{255, 0, 255}, 3);
+            }
+            std::printf("\n");
+            char file[64];
+            std::snprintf(file, sizeof file, "/left_%s_%04.1fm.png", name.c_str(), north);
+            rig::camera::write_png(directory + file, *frame);
+        }
+    }
+    rig::emulators::vision::CalibrationBoards boards;
+    boards.boom_board_right_m = config.model.mounting.right_m;
+    boards.nozzle_right_m = config.nozzle_right_m;
+    CropCoverParams bare;
+    bare.default_cover = CoverClass::bare;
+    const auto calibration = CameraEmulator(cameras[0].second, 1, 0, "left").render_calibration(CropCoverMap(bare, 1), BoomPose{}, boards, 0);
+    rig::camera::write_png(directory + "/left_calibration.png", *calibration);
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--density-survey") == 0) return density_survey();
+        if (std::strcmp(argv[i], "--frames") == 0 && i + 1 < argc) return write_frames(argv[i + 1]);
     }
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -1,13 +1,13 @@
 #include "emulators/field2d/crop_cover_map.h"
 
-#include "emulators/field2d/counter_hash.h"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include "emulators/field2d/counter_hash.h"
+#include "rig/camera/parameter_check.h"
 
 namespace rig::field2d {
 
@@ -42,14 +42,11 @@ std::uint64_t tile_key(std::int64_t east, std::int64_t north) {
     return (static_cast<std::uint64_t>(east) << 32) ^ (static_cast<std::uint64_t>(north) & 0xffffffffULL);
 }
 
+// The crop's parameters are checked like the cameras' (one message shape).
 void require(bool ok, const char* field, double value, const char* bounds) {
-    if (ok) return;
-    std::ostringstream message;
-    message << "crop." << field << ": " << value << " is outside " << bounds;
-    throw std::invalid_argument(message.str());
+    rig::camera::require_parameter(ok, "crop", field, value, bounds);
 }
-
-bool within(double value, double low, double high) { return std::isfinite(value) && value >= low && value <= high; }
+using rig::camera::finite_within;
 
 // Squared distance from p to the segment a-b.
 double segment_distance_sq(double px, double py, double ax, double ay, double bx, double by) {
@@ -102,20 +99,20 @@ const char* cover_class_name(CoverClass cover) {
 }
 
 void validate(const CropCoverParams& p) {
-    require(within(p.row_spacing_m, 0.05, 1.0), "row_spacing_m", p.row_spacing_m, "[0.05, 1.0] m");
-    require(within(p.row_bearing_deg, 0.0, 360.0) && p.row_bearing_deg < 360.0, "row_bearing_deg", p.row_bearing_deg, "[0, 360) deg");
-    require(within(p.row_offset_m, -p.row_spacing_m, p.row_spacing_m), "row_offset_m", p.row_offset_m, "[-row_spacing_m, row_spacing_m]");
-    require(within(p.row_scatter_m, 0.0, 0.1), "row_scatter_m", p.row_scatter_m, "[0, 0.1] m");
-    require(within(p.normal_plants_per_m, 0.0, 1000.0), "normal_plants_per_m", p.normal_plants_per_m, "[0, 1000] 1/m");
-    require(within(p.sparse_plants_per_m, 0.0, 1000.0), "sparse_plants_per_m", p.sparse_plants_per_m, "[0, 1000] 1/m");
-    require(within(p.plant_height_min_m, 1e-9, 1.0), "plant_height_min_m", p.plant_height_min_m, "(0, 1] m");
-    require(within(p.plant_height_max_m, p.plant_height_min_m, 1.0), "plant_height_max_m", p.plant_height_max_m, "[plant_height_min_m, 1] m");
+    require(finite_within(p.row_spacing_m, 0.05, 1.0), "row_spacing_m", p.row_spacing_m, "[0.05, 1.0] m");
+    require(finite_within(p.row_bearing_deg, 0.0, 360.0) && p.row_bearing_deg < 360.0, "row_bearing_deg", p.row_bearing_deg, "[0, 360) deg");
+    require(finite_within(p.row_offset_m, -p.row_spacing_m, p.row_spacing_m), "row_offset_m", p.row_offset_m, "[-row_spacing_m, row_spacing_m]");
+    require(finite_within(p.row_scatter_m, 0.0, 0.1), "row_scatter_m", p.row_scatter_m, "[0, 0.1] m");
+    require(finite_within(p.normal_plants_per_m, 0.0, 1000.0), "normal_plants_per_m", p.normal_plants_per_m, "[0, 1000] 1/m");
+    require(finite_within(p.sparse_plants_per_m, 0.0, 1000.0), "sparse_plants_per_m", p.sparse_plants_per_m, "[0, 1000] 1/m");
+    require(finite_within(p.plant_height_min_m, 1e-9, 1.0), "plant_height_min_m", p.plant_height_min_m, "(0, 1] m");
+    require(finite_within(p.plant_height_max_m, p.plant_height_min_m, 1.0), "plant_height_max_m", p.plant_height_max_m, "[plant_height_min_m, 1] m");
     require(p.leaves_min >= 1 && p.leaves_min <= 20, "leaves_min", p.leaves_min, "[1, 20]");
     require(p.leaves_max >= p.leaves_min && p.leaves_max <= 20, "leaves_max", p.leaves_max, "[leaves_min, 20]");
-    require(within(p.leaf_length_per_height_min, 1e-9, 5.0), "leaf_length_per_height_min", p.leaf_length_per_height_min, "(0, 5]");
-    require(within(p.leaf_length_per_height_max, p.leaf_length_per_height_min, 5.0), "leaf_length_per_height_max",
+    require(finite_within(p.leaf_length_per_height_min, 1e-9, 5.0), "leaf_length_per_height_min", p.leaf_length_per_height_min, "(0, 5]");
+    require(finite_within(p.leaf_length_per_height_max, p.leaf_length_per_height_min, 5.0), "leaf_length_per_height_max",
             p.leaf_length_per_height_max, "[leaf_length_per_height_min, 5]");
-    require(within(p.leaf_width_m, 0.001, 0.05), "leaf_width_m", p.leaf_width_m, "[0.001, 0.05] m");
+    require(finite_within(p.leaf_width_m, 0.001, 0.05), "leaf_width_m", p.leaf_width_m, "[0.001, 0.05] m");
 }
 
 CropCoverMap::CropCoverMap(CropCoverParams params, std::uint64_t seed) : params_(std::move(params)), seed_(seed) {

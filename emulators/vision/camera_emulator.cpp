@@ -6,29 +6,24 @@
 #include <stdexcept>
 
 #include "emulators/field2d/counter_hash.h"
+#include "rig/camera/parameter_check.h"
 
 namespace rig::emulators::vision {
 
 namespace {
 
+using rig::camera::finite_within;
+using rig::camera::require_parameter;
+
 using rig::camera::Rgb;
 using rig::camera::RgbImage;
 using rig::field2d::Vec2;
 
-void require(bool ok, const std::string& where, const char* field, double value, const char* bounds) {
-    if (ok) return;
-    std::ostringstream message;
-    message << where << "." << field << ": " << value << " is outside " << bounds;
-    throw std::invalid_argument(message.str());
-}
-
-bool within(double value, double low, double high) { return std::isfinite(value) && value >= low && value <= high; }
-
 void require_gains(const ChannelGains& gains, const std::string& where, const char* which) {
     const std::string prefix = where + "." + which;
-    require(within(gains.red, 0.0, 4.0), prefix, "red", gains.red, "[0, 4]");
-    require(within(gains.green, 0.0, 4.0), prefix, "green", gains.green, "[0, 4]");
-    require(within(gains.blue, 0.0, 4.0), prefix, "blue", gains.blue, "[0, 4]");
+    require_parameter(finite_within(gains.red, 0.0, 4.0), prefix, "red", gains.red, "[0, 4]");
+    require_parameter(finite_within(gains.green, 0.0, 4.0), prefix, "green", gains.green, "[0, 4]");
+    require_parameter(finite_within(gains.blue, 0.0, 4.0), prefix, "blue", gains.blue, "[0, 4]");
 }
 
 rig::camera::CameraModel with_pitch_fault(rig::camera::CameraModel model, double pitch_offset_deg) {
@@ -54,13 +49,13 @@ std::uint8_t to_byte(double value) {
 
 void validate(const CameraEmulatorParams& p, const std::string& where) {
     rig::camera::validate(p.camera, where + ".camera");
-    require(within(p.noise_sd_dn, 0.0, 50.0), where, "noise_sd_dn", p.noise_sd_dn, "[0, 50] DN");
-    require(within(p.lighting_gain, 0.0, 4.0), where, "lighting_gain", p.lighting_gain, "[0, 4]");
+    require_parameter(finite_within(p.noise_sd_dn, 0.0, 50.0), where, "noise_sd_dn", p.noise_sd_dn, "[0, 50] DN");
+    require_parameter(finite_within(p.lighting_gain, 0.0, 4.0), where, "lighting_gain", p.lighting_gain, "[0, 4]");
     require_gains(p.lighting_cast, where, "lighting_cast");
-    require(p.samples_per_axis >= 1 && p.samples_per_axis <= 8, where, "samples_per_axis", p.samples_per_axis, "[1, 8]");
-    require(within(p.frame_rate_hz, 1e-9, 120.0), where, "frame_rate_hz", p.frame_rate_hz, "(0, 120] Hz");
-    require(within(p.faults.pitch_offset_deg, -30.0, 30.0), where, "faults.pitch_offset_deg", p.faults.pitch_offset_deg, "[-30, 30] deg");
-    require(p.faults.blur_radius_px >= 0 && p.faults.blur_radius_px <= 50, where, "faults.blur_radius_px", p.faults.blur_radius_px, "[0, 50] px");
+    require_parameter(p.samples_per_axis >= 1 && p.samples_per_axis <= 8, where, "samples_per_axis", p.samples_per_axis, "[1, 8]");
+    require_parameter(finite_within(p.frame_rate_hz, 1e-9, 120.0), where, "frame_rate_hz", p.frame_rate_hz, "(0, 120] Hz");
+    require_parameter(finite_within(p.faults.pitch_offset_deg, -30.0, 30.0), where, "faults.pitch_offset_deg", p.faults.pitch_offset_deg, "[-30, 30] deg");
+    require_parameter(p.faults.blur_radius_px >= 0 && p.faults.blur_radius_px <= 50, where, "faults.blur_radius_px", p.faults.blur_radius_px, "[0, 50] px");
     require_gains(p.faults.colour_cast, where, "faults.colour_cast");
     // The knocked camera must still be a camera the model can hold.
     rig::camera::validate(with_pitch_fault(p.camera, p.faults.pitch_offset_deg), where + ".camera (with faults.pitch_offset_deg)");
@@ -107,13 +102,13 @@ std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap&
 std::optional<RgbImage> CameraEmulator::render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                            const CalibrationBoards& boards, std::uint64_t frame_index) const {
     const std::string where = name_ + ".calibration_boards";
-    require(within(boards.boom_board_length_m, 1e-3, 5.0), where, "boom_board_length_m", boards.boom_board_length_m, "[0.001, 5] m");
-    require(within(boards.boom_board_width_m, 1e-3, 1.0), where, "boom_board_width_m", boards.boom_board_width_m, "[0.001, 1] m");
-    require(within(boards.boom_board_right_m, -10.0, 10.0), where, "boom_board_right_m", boards.boom_board_right_m, "[-10, 10] m");
-    require(within(boards.nozzle_board_length_m, 1e-3, 1.0), where, "nozzle_board_length_m", boards.nozzle_board_length_m, "[0.001, 1] m");
-    require(within(boards.nozzle_board_width_m, 1e-3, 1.0), where, "nozzle_board_width_m", boards.nozzle_board_width_m, "[0.001, 1] m");
-    require(within(boards.nozzle_board_ahead_m, -2.0, 2.0), where, "nozzle_board_ahead_m", boards.nozzle_board_ahead_m, "[-2, 2] m");
-    for (const double x : boards.nozzle_right_m) require(within(x, -10.0, 10.0), where, "nozzle_right_m[]", x, "[-10, 10] m");
+    require_parameter(finite_within(boards.boom_board_length_m, 1e-3, 5.0), where, "boom_board_length_m", boards.boom_board_length_m, "[0.001, 5] m");
+    require_parameter(finite_within(boards.boom_board_width_m, 1e-3, 1.0), where, "boom_board_width_m", boards.boom_board_width_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.boom_board_right_m, -10.0, 10.0), where, "boom_board_right_m", boards.boom_board_right_m, "[-10, 10] m");
+    require_parameter(finite_within(boards.nozzle_board_length_m, 1e-3, 1.0), where, "nozzle_board_length_m", boards.nozzle_board_length_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.nozzle_board_width_m, 1e-3, 1.0), where, "nozzle_board_width_m", boards.nozzle_board_width_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.nozzle_board_ahead_m, -2.0, 2.0), where, "nozzle_board_ahead_m", boards.nozzle_board_ahead_m, "[-2, 2] m");
+    for (const double x : boards.nozzle_right_m) require_parameter(finite_within(x, -10.0, 10.0), where, "nozzle_right_m[]", x, "[-10, 10] m");
     return render_scene(crop, pose, &boards, frame_index);
 }
 
@@ -137,7 +132,7 @@ std::optional<Rgb> board_at(const CalibrationBoards& boards, double x, double y)
 
 std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                      const CalibrationBoards* boards, std::uint64_t frame_index) const {
-    if (!within(pose.boom_height_m, 1e-9, 5.0)) {
+    if (!finite_within(pose.boom_height_m, 1e-9, 5.0)) {
         std::ostringstream message;
         message << name_ << ": boom height " << pose.boom_height_m << " m is outside (0, 5] m";
         throw std::invalid_argument(message.str());

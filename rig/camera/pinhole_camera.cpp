@@ -2,8 +2,9 @@
 
 #include <cmath>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
+
+#include "rig/camera/parameter_check.h"
 
 namespace rig::camera {
 
@@ -11,38 +12,29 @@ namespace {
 
 double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
-void require(bool ok, const std::string& where, const char* field, double value, const char* bounds) {
-    if (ok) return;
-    std::ostringstream message;
-    message << where << "." << field << ": " << value << " is outside " << bounds;
-    throw std::invalid_argument(message.str());
-}
-
-bool within(double value, double low, double high) { return std::isfinite(value) && value >= low && value <= high; }
-
 }  // namespace
 
 void validate(const CameraModel& model, const std::string& where) {
     const CameraIntrinsics& k = model.intrinsics;
-    require(k.width_px >= 16 && k.width_px <= 8192, where, "intrinsics.width_px", k.width_px, "[16, 8192]");
-    require(k.height_px >= 16 && k.height_px <= 8192, where, "intrinsics.height_px", k.height_px, "[16, 8192]");
-    require(within(k.fx_px, 1e-9, 1e5), where, "intrinsics.fx_px", k.fx_px, "(0, 100000]");
-    require(within(k.fy_px, 1e-9, 1e5), where, "intrinsics.fy_px", k.fy_px, "(0, 100000]");
-    require(within(k.cx_px, 0.0, k.width_px), where, "intrinsics.cx_px", k.cx_px, "[0, width_px]");
-    require(within(k.cy_px, 0.0, k.height_px), where, "intrinsics.cy_px", k.cy_px, "[0, height_px]");
+    require_parameter(k.width_px >= 16 && k.width_px <= 8192, where, "intrinsics.width_px", k.width_px, "[16, 8192]");
+    require_parameter(k.height_px >= 16 && k.height_px <= 8192, where, "intrinsics.height_px", k.height_px, "[16, 8192]");
+    require_parameter(finite_within(k.fx_px, 1e-9, 1e5), where, "intrinsics.fx_px", k.fx_px, "(0, 100000]");
+    require_parameter(finite_within(k.fy_px, 1e-9, 1e5), where, "intrinsics.fy_px", k.fy_px, "(0, 100000]");
+    require_parameter(finite_within(k.cx_px, 0.0, k.width_px), where, "intrinsics.cx_px", k.cx_px, "[0, width_px]");
+    require_parameter(finite_within(k.cy_px, 0.0, k.height_px), where, "intrinsics.cy_px", k.cy_px, "[0, height_px]");
     const BrownConradyDistortion& d = model.distortion;
-    require(within(d.k1, -1.0, 1.0), where, "distortion.k1", d.k1, "[-1, 1]");
-    require(within(d.k2, -1.0, 1.0), where, "distortion.k2", d.k2, "[-1, 1]");
-    require(within(d.k3, -1.0, 1.0), where, "distortion.k3", d.k3, "[-1, 1]");
-    require(within(d.p1, -1.0, 1.0), where, "distortion.p1", d.p1, "[-1, 1]");
-    require(within(d.p2, -1.0, 1.0), where, "distortion.p2", d.p2, "[-1, 1]");
+    require_parameter(finite_within(d.k1, -1.0, 1.0), where, "distortion.k1", d.k1, "[-1, 1]");
+    require_parameter(finite_within(d.k2, -1.0, 1.0), where, "distortion.k2", d.k2, "[-1, 1]");
+    require_parameter(finite_within(d.k3, -1.0, 1.0), where, "distortion.k3", d.k3, "[-1, 1]");
+    require_parameter(finite_within(d.p1, -1.0, 1.0), where, "distortion.p1", d.p1, "[-1, 1]");
+    require_parameter(finite_within(d.p2, -1.0, 1.0), where, "distortion.p2", d.p2, "[-1, 1]");
     const CameraMounting& m = model.mounting;
-    require(within(m.right_m, -10.0, 10.0), where, "mounting.right_m", m.right_m, "[-10, 10] m");
-    require(within(m.forward_m, -2.0, 2.0), where, "mounting.forward_m", m.forward_m, "[-2, 2] m");
-    require(within(m.above_boom_m, 1e-9, 5.0), where, "mounting.above_boom_m", m.above_boom_m, "(0, 5] m");
-    require(within(m.pitch_deg, 0.0, 85.0), where, "mounting.pitch_deg", m.pitch_deg, "[0, 85] deg");
-    require(within(m.roll_deg, -45.0, 45.0), where, "mounting.roll_deg", m.roll_deg, "[-45, 45] deg");
-    require(within(m.yaw_deg, -45.0, 45.0), where, "mounting.yaw_deg", m.yaw_deg, "[-45, 45] deg");
+    require_parameter(finite_within(m.right_m, -10.0, 10.0), where, "mounting.right_m", m.right_m, "[-10, 10] m");
+    require_parameter(finite_within(m.forward_m, -2.0, 2.0), where, "mounting.forward_m", m.forward_m, "[-2, 2] m");
+    require_parameter(finite_within(m.above_boom_m, 1e-9, 5.0), where, "mounting.above_boom_m", m.above_boom_m, "(0, 5] m");
+    require_parameter(finite_within(m.pitch_deg, 0.0, 85.0), where, "mounting.pitch_deg", m.pitch_deg, "[0, 85] deg");
+    require_parameter(finite_within(m.roll_deg, -45.0, 45.0), where, "mounting.roll_deg", m.roll_deg, "[-45, 45] deg");
+    require_parameter(finite_within(m.yaw_deg, -45.0, 45.0), where, "mounting.yaw_deg", m.yaw_deg, "[-45, 45] deg");
 }
 
 CameraModel seed001_boom_camera(bool right_camera) {

@@ -6,26 +6,21 @@
 
 #include "controller/boundary/boundary_equations.h"
 #include "controller/boundary/vision/image_ops.h"
+#include "rig/camera/parameter_check.h"
 
 namespace rig::controller::boundary::vision {
 
 namespace {
 
-bool within(double value, double low, double high) { return std::isfinite(value) && value >= low && value <= high; }
-
-void require(bool ok, const std::string& where, const char* field, double value, const char* bounds) {
-    if (ok) return;
-    std::ostringstream message;
-    message << where << "." << field << ": " << value << " is outside " << bounds;
-    throw std::invalid_argument(message.str());
-}
+using rig::camera::finite_within;
+using rig::camera::require_parameter;
 
 std::string camera_where(const VisionCameraConfig& camera, std::size_t index) {
     return "vision.cameras[" + std::to_string(index) + "] '" + camera.name + "'";
 }
 
 void require_boom_height(double boom_height_m) {
-    if (!within(boom_height_m, 1e-9, 5.0)) {
+    if (!finite_within(boom_height_m, 1e-9, 5.0)) {
         std::ostringstream message;
         message << "vision: boom height " << boom_height_m << " m is outside (0, 5] m";
         throw std::invalid_argument(message.str());
@@ -47,13 +42,13 @@ Eigen::Vector2d apply(const Eigen::Matrix3d& homography, const Eigen::Vector2d& 
 
 void validate(const VisionParams& p) {
     const std::string where = "vision";
-    require(within(p.roi_width_m, 1e-9, 5.0), where, "roi_width_m", p.roi_width_m, "(0, 5] m");
-    require(within(p.roi_near_m, -2.0, 5.0), where, "roi_near_m", p.roi_near_m, "[-2, 5] m");
-    require(within(p.roi_depth_m, 1e-9, 5.0), where, "roi_depth_m", p.roi_depth_m, "(0, 5] m");
-    require(within(p.warp_mm_per_px, 0.5, 50.0), where, "warp_mm_per_px", p.warp_mm_per_px, "[0.5, 50] mm");
-    require(p.exg_floor >= 0 && p.exg_floor <= 255, where, "exg_floor", p.exg_floor, "[0, 255]");
-    require(within(p.dark_frame_mean_max_dn, 0.0, 255.0), where, "dark_frame_mean_max_dn", p.dark_frame_mean_max_dn, "[0, 255]");
-    require(within(p.min_roi_share_in_frame, 1e-9, 1.0), where, "min_roi_share_in_frame", p.min_roi_share_in_frame, "(0, 1]");
+    require_parameter(finite_within(p.roi_width_m, 1e-9, 5.0), where, "roi_width_m", p.roi_width_m, "(0, 5] m");
+    require_parameter(finite_within(p.roi_near_m, -2.0, 5.0), where, "roi_near_m", p.roi_near_m, "[-2, 5] m");
+    require_parameter(finite_within(p.roi_depth_m, 1e-9, 5.0), where, "roi_depth_m", p.roi_depth_m, "(0, 5] m");
+    require_parameter(finite_within(p.warp_mm_per_px, 0.5, 50.0), where, "warp_mm_per_px", p.warp_mm_per_px, "[0.5, 50] mm");
+    require_parameter(p.exg_floor >= 0 && p.exg_floor <= 255, where, "exg_floor", p.exg_floor, "[0, 255]");
+    require_parameter(finite_within(p.dark_frame_mean_max_dn, 0.0, 255.0), where, "dark_frame_mean_max_dn", p.dark_frame_mean_max_dn, "[0, 255]");
+    require_parameter(finite_within(p.min_roi_share_in_frame, 1e-9, 1.0), where, "min_roi_share_in_frame", p.min_roi_share_in_frame, "(0, 1]");
 }
 
 void validate(const VisionCameraConfig& camera, std::size_t index) {
@@ -62,7 +57,7 @@ void validate(const VisionCameraConfig& camera, std::size_t index) {
     rig::camera::validate(camera.model, where + ".model");
     if (camera.nozzles.empty()) throw std::invalid_argument(where + ".nozzles: empty (a camera sees at least one nozzle)");
     for (std::size_t i = 0; i < camera.nozzles.size(); ++i) {
-        require(camera.nozzles[i] >= 0 && camera.nozzles[i] < 32, where, ("nozzles[" + std::to_string(i) + "]").c_str(),
+        require_parameter(camera.nozzles[i] >= 0 && camera.nozzles[i] < 32, where, ("nozzles[" + std::to_string(i) + "]").c_str(),
                 camera.nozzles[i], "[0, 31]");
     }
     if (camera.nozzle_pixels.empty()) {
@@ -71,7 +66,7 @@ void validate(const VisionCameraConfig& camera, std::size_t index) {
                                         " positions for " + std::to_string(camera.nozzles.size()) + " nozzles");
         }
         for (std::size_t i = 0; i < camera.nozzle_right_m.size(); ++i) {
-            require(within(camera.nozzle_right_m[i], -20.0, 20.0), where, ("nozzle_right_m[" + std::to_string(i) + "]").c_str(),
+            require_parameter(finite_within(camera.nozzle_right_m[i], -20.0, 20.0), where, ("nozzle_right_m[" + std::to_string(i) + "]").c_str(),
                     camera.nozzle_right_m[i], "[-20, 20] m");
         }
     } else if (camera.nozzle_pixels.size() != camera.nozzles.size()) {
@@ -81,8 +76,8 @@ void validate(const VisionCameraConfig& camera, std::size_t index) {
         for (std::size_t i = 0; i < camera.nozzle_pixels.size(); ++i) {
             const PixelPoint& p = camera.nozzle_pixels[i];
             const std::string field = "nozzle_pixels[" + std::to_string(i) + "].";
-            require(within(p.u_px, -1e4, 1e4), where, (field + "u_px").c_str(), p.u_px, "[-10000, 10000] px");
-            require(within(p.v_px, -1e4, 1e4), where, (field + "v_px").c_str(), p.v_px, "[-10000, 10000] px");
+            require_parameter(finite_within(p.u_px, -1e4, 1e4), where, (field + "u_px").c_str(), p.u_px, "[-10000, 10000] px");
+            require_parameter(finite_within(p.v_px, -1e4, 1e4), where, (field + "v_px").c_str(), p.v_px, "[-10000, 10000] px");
         }
     }
 }
