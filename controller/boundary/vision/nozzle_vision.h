@@ -135,7 +135,9 @@ public:
     // Eq. 5-8 at boom height h (the L4's reading, m). Throws
     // std::invalid_argument for h outside (0, 5] m.
     std::vector<NozzleRoi> rois(double boom_height_m) const;
-    // Eq. 15-17 on a frame (nullptr: the camera delivered none).
+    // Eq. 15-17 on a frame (nullptr: the camera delivered none). What the
+    // frame holds never throws (a missing, dark or wrong-sized frame is a
+    // status); a boom height outside (0, 5] m throws std::invalid_argument.
     FrameDensities measure(const rig::camera::RgbImage* frame, double boom_height_m) const;
     // A ROI warped to its rectangle (w x h2 at warp_mm_per_px; far edge at the
     // top), pixels outside the frame black: for reports and tests.
