@@ -139,6 +139,8 @@ TEST(CropCoverMap, BadInputIsNamed) {
     EXPECT_THROW(map.cover_fraction({Vec2{0, 0}, Vec2{1, 1}, Vec2{1, 0}, Vec2{0, 1}}), std::invalid_argument);  // bow-tie
     EXPECT_THROW(map.cover_fraction({Vec2{0, 0}, Vec2{NAN, 0}, Vec2{1, 1}, Vec2{0, 1}}), std::invalid_argument);
     EXPECT_THROW(map.cover_fraction(rectangle(0.0, 0.0, 0.0001, 0.0001)), std::invalid_argument);  // no cell centre inside
+    EXPECT_THROW((void)map.is_plant(Vec2{NAN, 0.0}), std::invalid_argument);
+    EXPECT_THROW((void)map.is_plant(Vec2{0.0, 2e6}), std::invalid_argument);
 }
 
 }  // namespace

@@ -15,7 +15,8 @@ namespace {
 
 // Tiles of 256 x 256 cells (0.256 m): a camera's view (about 2.6 x 0.9 m of
 // ground) touches some 40 of them.
-constexpr int kTileCells = 256;
+constexpr int kTileShift = 8;
+constexpr int kTileCells = 1 << kTileShift;
 constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
 // Beyond this many cached tiles (64 KiB each) the cache starts again: tiles
 // are pure functions of the seed, so dropping them changes nothing but time.
@@ -36,6 +37,11 @@ int poisson(HashStream& stream, double mean) {
         if (probability < 1e-300 && count > mean) break;  // the tail is exhausted (rounding left u above 1 - eps)
     }
     return count;
+}
+
+std::int64_t floor_to_int(double value) {
+    const auto truncated = static_cast<std::int64_t>(value);
+    return static_cast<double>(truncated) > value ? truncated - 1 : truncated;
 }
 
 std::uint64_t tile_key(std::int64_t east, std::int64_t north) {
@@ -130,13 +136,18 @@ CoverClass CropCoverMap::cover_class_at(Vec2 ground) const {
 }
 
 bool CropCoverMap::is_plant(Vec2 ground) const {
-    const double east_cells = std::floor(ground.east_m / kCellM);
-    const double north_cells = std::floor(ground.north_m / kCellM);
-    const auto east = static_cast<std::int64_t>(east_cells);
-    const auto north = static_cast<std::int64_t>(north_cells);
-    // Floor division into tiles and cells within them.
-    const std::int64_t tile_east = east >= 0 ? east / kTileCells : -((-east - 1) / kTileCells) - 1;
-    const std::int64_t tile_north = north >= 0 ? north / kTileCells : -((-north - 1) / kTileCells) - 1;
+    // The renderer asks this four times a pixel: std::floor is a libm call on
+    // the baseline x86-64 target, so the floors are done by truncation.
+    // (Within 1000 km of the origin: a field, and far inside int64 cells.)
+    if (!(std::abs(ground.east_m) < 1e6 && std::abs(ground.north_m) < 1e6)) {
+        throw std::invalid_argument("crop is_plant: (" + std::to_string(ground.east_m) + ", " + std::to_string(ground.north_m) +
+                                    ") m is not a ground point within 1000 km of the origin");
+    }
+    const std::int64_t east = floor_to_int(ground.east_m / kCellM);
+    const std::int64_t north = floor_to_int(ground.north_m / kCellM);
+    // Floor division into tiles (an arithmetic shift: kTileCells is 2^8) and cells within them.
+    const std::int64_t tile_east = east >> kTileShift;
+    const std::int64_t tile_north = north >> kTileShift;
     const Tile& t = tile(tile_east, tile_north);
     const auto i = static_cast<std::size_t>(east - tile_east * kTileCells);
     const auto j = static_cast<std::size_t>(north - tile_north * kTileCells);

@@ -86,7 +86,8 @@ public:
     CropCoverMap(CropCoverMap&&) noexcept;
     CropCoverMap& operator=(CropCoverMap&&) noexcept;
 
-    // True where the 1 mm cell holding `ground` is plant.
+    // True where the 1 mm cell holding `ground` is plant. Throws
+    // std::invalid_argument for a non-finite point or one 1000 km or more away.
     bool is_plant(Vec2 ground) const;
     // The class of the ground at a point (the last patch holding it, else the default).
     CoverClass cover_class_at(Vec2 ground) const;

@@ -41,8 +41,12 @@ double unit_noise(std::uint64_t bits) {
     return (sum - 2.0) * 1.7320508075688772;  // sqrt(3)
 }
 
+// Rounded to the nearest byte and clipped (half away from zero, as lround;
+// written out because lround is a libm call and this runs three times a pixel).
 std::uint8_t to_byte(double value) {
-    return static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+    if (!(value > 0.0)) return 0;
+    if (value >= 255.0) return 255;
+    return static_cast<std::uint8_t>(value + 0.5);
 }
 
 }  // namespace
