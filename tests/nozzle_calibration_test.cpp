@@ -54,6 +54,8 @@ TEST(NozzleCalibration, FindsTheNozzlePointsOfBothCameras) {
         ASSERT_EQ(found.nozzle_pixels.size(), 3U);
         // The boom line is nearly level in the image, like Eq. 1 (slope -0.00255).
         EXPECT_LT(std::abs(found.boom_line->direction.y() / found.boom_line->direction.x()), 0.05);
+        EXPECT_LT(found.boom_line->spread_ratio, 0.5);
+        for (const ImageLine& line : found.nozzle_lines) EXPECT_LT(line.spread_ratio, 0.5);
         // Within 4 px of the true projection: the least-squares line through a
         // board's pixels is not exactly the image of the board's centre line
         // (perspective: the nearer half of a board covers more pixels), a bias
@@ -95,6 +97,13 @@ TEST(NozzleCalibration, SaysWhatIsMissing) {
     const NozzleCalibration short_one = find_nozzle_points(*frame, model, 3);
     EXPECT_FALSE(short_one.ok);
     EXPECT_NE(short_one.problem.find("found 2 red nozzle boards, expected 3"), std::string::npos) << short_one.problem;
+    // Calibrating over the crop: the plants are green too, and the green
+    // pixels are no longer one board. Refused, not a boom line through wheat.
+    const CropCoverMap wheat(CropCoverParams{}, 3);
+    const auto over_crop = camera.render_calibration(wheat, pose, boards_for(config), 0);
+    const NozzleCalibration cropped = find_nozzle_points(*over_crop, model, 3);
+    EXPECT_FALSE(cropped.ok);
+    EXPECT_NE(cropped.problem.find("green pixels do not form one board"), std::string::npos) << cropped.problem;
 }
 
 TEST(FramePng, RoundTripsAFrameWithItsRoisDrawn) {

@@ -26,6 +26,8 @@ ImageLine fit_line(const std::vector<Eigen::Vector2d>& points) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
     line.point = centroid;
     line.direction = solver.eigenvectors().col(1).normalized();  // the larger eigenvalue's
+    const double along = solver.eigenvalues()(1);
+    line.spread_ratio = along > 0.0 ? std::sqrt(std::max(0.0, solver.eigenvalues()(0)) / along) : 1.0;
     return line;
 }
 
@@ -37,6 +39,9 @@ std::optional<Eigen::Vector2d> intersect(const ImageLine& a, const ImageLine& b)
     const Eigen::Vector2d t = m.inverse() * (b.point - a.point);
     return a.point + t.x() * a.direction;
 }
+
+// Boards are 0.3 as wide as long; above this the pixels are not one board.
+constexpr double kMaxSpreadRatio = 0.5;
 
 int threshold_of(const Histogram& histogram, int floor) { return std::max(otsu_threshold(histogram).value_or(256), floor); }
 
@@ -85,6 +90,11 @@ NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const r
         return result;
     }
     result.boom_line = fit_line(green_points);
+    if (result.boom_line->spread_ratio > kMaxSpreadRatio) {
+        result.problem = "the green pixels do not form one board (spread across / along " +
+                         std::to_string(result.boom_line->spread_ratio) + " > 0.5): crop or other green in view?";
+        return result;
+    }
 
     // Split the red pixels into boards at the gaps between their columns.
     std::sort(red_points.begin(), red_points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x(); });
@@ -102,6 +112,11 @@ NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const r
     }
     for (const std::vector<Eigen::Vector2d>& board : boards) {
         const ImageLine line = fit_line(board);
+        if (line.spread_ratio > kMaxSpreadRatio) {
+            result.problem = "red pixels around column " + std::to_string(static_cast<int>(line.point.x())) +
+                             " do not form one board (spread across / along " + std::to_string(line.spread_ratio) + " > 0.5)";
+            return result;
+        }
         const std::optional<Eigen::Vector2d> crossing = intersect(*result.boom_line, line);
         if (!crossing) {
             result.problem = "a nozzle board's line runs parallel to the boom board's";

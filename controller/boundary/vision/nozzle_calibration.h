@@ -31,6 +31,10 @@ struct ImageLine {
     Eigen::Vector2d point;      // the pixels' centroid (undistorted image)
     Eigen::Vector2d direction;  // unit
     long pixels = 0;
+    // The pixels' spread across the line over their spread along it (SDs): a
+    // board's is about its width over its length (0.3 for both boards, 90 /
+    // 300 and 50 / 190 mm); a scatter of plants' is near 1.
+    double spread_ratio = 0.0;
 };
 
 struct NozzleCalibration {
@@ -46,8 +50,10 @@ struct NozzleCalibration {
 // `model`: the camera's intrinsics and distortion (its mounting is not used).
 // `colour_floor`: the least index counted as board whatever Otsu finds
 // (assumed 60: boards are saturated colours, index ~150, soil ~0).
-// Never throws for what the image holds: a frame without the boards, or with
-// another number of red boards than `nozzle_count`, gives ok = false and says why.
+// Never throws for what the image holds: a frame without the boards, with
+// another number of red boards than `nozzle_count`, or with green or red
+// pixels that do not form a board (spread ratio above 0.5: a crop in view;
+// the paper calibrates on a platform, Fig. 5) gives ok = false and says why.
 NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                      std::size_t nozzle_count, int colour_floor = 60);
 
