@@ -123,6 +123,18 @@ TEST(CropCoverMap, CoverFractionIsTheShareOfPlantCellsInside) {
     EXPECT_NEAR(map.cover_fraction(quad), static_cast<double>(plant) / static_cast<double>(inside), 0.002);
 }
 
+TEST(NozzleRoiGround, Sec21RectangleAheadOfTheNozzle) {
+    // Heading east (90 deg): ahead is +east, right is -north. Nozzle 0.25 m
+    // right of a boom centre at (10, 20): its ROI runs 0.2-0.6 m east of it,
+    // 0.3 m either side across.
+    const std::array<Vec2, 4> roi = nozzle_roi_ground({10.0, 20.0}, 90.0, 0.25);
+    EXPECT_NEAR(roi[0].east_m, 10.2, 1e-12);
+    EXPECT_NEAR(roi[0].north_m, 20.0 - 0.25 + 0.3, 1e-12);  // near-left
+    EXPECT_NEAR(roi[1].north_m, 20.0 - 0.25 - 0.3, 1e-12);  // near-right
+    EXPECT_NEAR(roi[2].east_m, 10.6, 1e-12);                // far
+    EXPECT_NEAR(roi[3].north_m, roi[0].north_m, 1e-12);
+}
+
 TEST(CropCoverMap, BadInputIsNamed) {
     CropCoverParams params;
     params.row_spacing_m = 0.0;

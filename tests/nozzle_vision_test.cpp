@@ -35,9 +35,7 @@ CameraVision left_vision() { return CameraVision(seed001_vision_cameras(Boundary
 // A nozzle's true ROI on the field: Sec. 2.1 laid out from the plant's own
 // geometry (boom centre, heading, nozzle i at (i - 2.5) x 0.5 m right).
 std::array<Vec2, 4> true_roi(const BoomPose& pose, int nozzle) {
-    const double x = (nozzle - 2.5) * 0.5;
-    auto at = [&](double right, double ahead) { return rig::field2d::body_to_field(pose.boom_centre_ground, pose.heading_deg, right, ahead); };
-    return {at(x - 0.3, 0.2), at(x + 0.3, 0.2), at(x + 0.3, 0.6), at(x - 0.3, 0.6)};
+    return rig::field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, (nozzle - 2.5) * 0.5);
 }
 
 // The ground a ROI's image corners truly see (the emulator's camera, faults included).

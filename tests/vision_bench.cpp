@@ -122,11 +122,8 @@ int density_survey() {
                         const FrameDensities result = vision.measure(image ? &*image : nullptr, 0.5);
                         for (const auto& nozzle : result.nozzles) {
                             if (!nozzle.measured) continue;
-                            const double x = (nozzle.nozzle - 2.5) * 0.5;
-                            auto at = [&](double right, double ahead) {
-                                return rig::field2d::body_to_field(pose.boom_centre_ground, pose.heading_deg, right, ahead);
-                            };
-                            const double truth = crop.cover_fraction({at(x - 0.3, 0.2), at(x + 0.3, 0.2), at(x + 0.3, 0.6), at(x - 0.3, 0.6)});
+                            const double truth = crop.cover_fraction(
+                                rig::field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, (nozzle.nozzle - 2.5) * 0.5));
                             errors.push_back(nozzle.density - truth);
                             true_sum += truth;
                             measured_sum += nozzle.density;
@@ -178,9 +175,8 @@ int write_frames(const std::string& directory) {
             const FrameDensities result = vision.measure(&*frame, 0.5);
             std::printf("%-12s boom at %.1f m:", name.c_str(), north);
             for (const auto& nozzle : result.nozzles) {
-                const double x = (nozzle.nozzle - 2.5) * 0.5;
-                auto at = [&](double right, double ahead) { return rig::field2d::body_to_field(pose.boom_centre_ground, pose.heading_deg, right, ahead); };
-                const double truth = crop.cover_fraction({at(x - 0.3, 0.2), at(x + 0.3, 0.2), at(x + 0.3, 0.6), at(x - 0.3, 0.6)});
+                const double truth = crop.cover_fraction(
+                    rig::field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, (nozzle.nozzle - 2.5) * 0.5));
                 std::printf("  nozzle %d D %.3f (true %.3f)", nozzle.nozzle, nozzle.density, truth);
                 rig::camera::draw_quad(*frame, nozzle.roi.image_px, rig::camera::Rgb{255, 0, 255}, 3);
             }

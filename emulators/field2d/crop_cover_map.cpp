@@ -284,4 +284,12 @@ double CropCoverMap::cover_fraction(const std::array<Vec2, 4>& corners) const {
     return static_cast<double>(plant) / static_cast<double>(inside);
 }
 
+std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m, double width_m,
+                                      double near_m, double depth_m) {
+    auto at = [&](double right, double ahead) { return body_to_field(boom_centre_ground, heading_deg, right, ahead); };
+    const double half = 0.5 * width_m;
+    return {at(nozzle_right_m - half, near_m), at(nozzle_right_m + half, near_m), at(nozzle_right_m + half, near_m + depth_m),
+            at(nozzle_right_m - half, near_m + depth_m)};
+}
+
 }  // namespace rig::field2d

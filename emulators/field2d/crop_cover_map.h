@@ -113,4 +113,12 @@ private:
     mutable std::uint64_t last_key_ = 0;
 };
 
+// Sec. 2.1's ground ROI of a nozzle, from the plant's truth: w across centred
+// on the nozzle, from `near_m` to `near_m + depth_m` ahead of its ground point,
+// square to the boom; corners near-left, near-right, far-right, far-left (the
+// order of cover_fraction and of the controller's NozzleRoi). Defaults: Sec.
+// 2.1's w = 600 mm, h1 = 200 mm, h2 = 400 mm.
+std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m,
+                                      double width_m = 0.600, double near_m = 0.200, double depth_m = 0.400);
+
 }  // namespace rig::field2d

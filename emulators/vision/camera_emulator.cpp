@@ -65,6 +65,10 @@ void validate(const CameraEmulatorParams& p, const std::string& where) {
     rig::camera::validate(with_pitch_fault(p.camera, p.faults.pitch_offset_deg), where + ".camera (with faults.pitch_offset_deg)");
 }
 
+BoomPose boom_pose_of(const rig::field2d::SprayerTruth& truth) {
+    return BoomPose{truth.boom_centre, truth.pose.heading_deg, truth.boom_height_m};
+}
+
 CameraEmulatorParams seed001_camera_params(bool right_camera) {
     CameraEmulatorParams params;
     params.camera = rig::camera::seed001_boom_camera(right_camera);

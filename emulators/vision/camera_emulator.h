@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "emulators/field2d/crop_cover_map.h"
+#include "emulators/field2d/sprayer_kinematics.h"
 #include "emulators/field2d/vec2.h"
 #include "rig/camera/pinhole_camera.h"
 #include "rig/camera/rgb_image.h"
@@ -89,6 +90,9 @@ struct BoomPose {
     double heading_deg = 0.0;     // compass, the travel direction
     double boom_height_m = 0.5;   // (0, 5]; Sec. 5.1: 0.5 m
 };
+
+// The boom pose of the 2-D plant's truth at some time.
+BoomPose boom_pose_of(const rig::field2d::SprayerTruth& truth);
 
 class CameraEmulator {
 public:
