@@ -279,6 +279,25 @@ TEST(NozzleVision, DeadCameraIsNoFrameNotZeroDensity) {
     EXPECT_NE(wrong.detail.find("640 x 360"), std::string::npos) << wrong.detail;
 }
 
+TEST(NozzleVision, RoiOutsideTheFrameHasNoDensity) {
+    // A ROI 2.0-2.4 m ahead: the camera 1.5 m up, 25 deg + half its 43.6 deg
+    // vertical field of view from the vertical, sees the ground to about
+    // 1.6 m ahead of itself, so the ROI lies above the frame's top.
+    VisionParams far_ahead;
+    far_ahead.roi_near_m = 2.0;
+    const CameraVision vision(seed001_vision_cameras(BoundaryControllerConfig{})[0], far_ahead);
+    const CropCoverMap crop(CropCoverParams{}, 2);
+    const CameraEmulator camera(rig::emulators::vision::seed001_camera_params(false), 2, 0, "left");
+    const auto image = camera.render(crop, BoomPose{{0.0, 0.0}, 0.0, 0.5}, 0);
+    const FrameDensities result = vision.measure(&*image, 0.5);
+    ASSERT_EQ(result.status, FrameStatus::ok);
+    for (const NozzleDensity& nozzle : result.nozzles) {
+        EXPECT_FALSE(nozzle.measured);
+        EXPECT_GT(nozzle.roi_px_outside, nozzle.roi_px);
+        EXPECT_FALSE(vision_spray_level(BoundaryControllerConfig{}, nozzle, 1.5).has_value());
+    }
+}
+
 TEST(NozzleVision, DirtyLensAndLowSunChangeTheFrame) {
     // The other named faults do something a metric can see: the blur smears
     // leaves into the soil (sparse cover reads high), the cast shifts colour.

@@ -9,9 +9,9 @@
 // Each pixel's colour is the soil / plant mix of its footprint (n x n samples
 // of the crop truth inside the pixel), times the lighting and colour cast,
 // plus seeded noise per channel, clipped to 0-255. The boom and nozzles are
-// not drawn: they sit below the ROIs in the image (Eq. 1-4's row ~660 against
-// the ROIs' 330-590 with the defaults) and nothing measures them in a working
-// frame; render_calibration() draws Sec. 2.2.1's boards.
+// not drawn: they sit below the ROIs in the image (the nozzles at row ~665,
+// Eq. 1-4's ~661, against the ROIs' rows 355-575 with the defaults) and nothing
+// measures them in a working frame; render_calibration() draws Sec. 2.2.1's boards.
 //
 // Named faults, ArduPilot SITL style (each off at its default):
 //   pitch_offset_deg  the camera knocked off the pitch it was calibrated at

@@ -126,8 +126,9 @@ CameraVision::CameraVision(VisionCameraConfig camera, VisionParams params, std::
             pixel = Eigen::Vector2d(camera_.nozzle_pixels[i].u_px, camera_.nozzle_pixels[i].v_px);
         }
         const Eigen::Vector3d h = pixel_to_boom_plane * Eigen::Vector3d(pixel.x(), pixel.y(), 1.0);
-        // A point above the horizon maps to the far side of the plane (w < 0 after
-        // the camera's own sign): refuse it rather than put an ROI behind the boom.
+        // A pixel whose ray never meets the boom plane (above that plane's
+        // horizon) still maps somewhere under H^-1: onto the plane behind the
+        // camera. Refuse it rather than put a ROI there.
         const Eigen::Vector3d in_camera = model_.axes_in_boom().transpose() *
                                           (Eigen::Vector3d(h.x() / h.z(), h.y() / h.z(), 0.0) - model_.position_in_boom());
         if (!std::isfinite(h.x() / h.z()) || in_camera.z() <= 0.0) {
@@ -237,6 +238,15 @@ FrameDensities CameraVision::measure(const rig::camera::RgbImage* frame, double 
         NozzleDensity nozzle;
         nozzle.nozzle = roi.nozzle;
         nozzle.roi = roi;
+        bool corners_in_view = true;
+        for (const Eigen::Vector2d& corner : roi.image_px) corners_in_view = corners_in_view && corner.allFinite();
+        if (!corners_in_view) {
+            // A corner behind the camera (a boom far too high or low for this
+            // mounting): the ROI is not in the frame at all.
+            nozzle.roi_px_outside = static_cast<long>(width) * height;
+            result.nozzles.push_back(nozzle);
+            continue;
+        }
         for_each_warped_pixel(model_, *frame, roi, width, height, [&](int, int, const std::optional<std::array<double, 3>>& colour) {
             if (!colour) {
                 ++nozzle.roi_px_outside;
