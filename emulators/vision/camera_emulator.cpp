@@ -104,20 +104,7 @@ std::optional<Vec2> CameraEmulator::ground_seen(const BoomPose& pose, double u, 
 
 std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                std::uint64_t frame_index) const {
-    return render_scene(crop, pose, nullptr, frame_index);
-}
-
-std::optional<RgbImage> CameraEmulator::render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
-                                                           const CalibrationBoards& boards, std::uint64_t frame_index) const {
-    const std::string where = name_ + ".calibration_boards";
-    require_parameter(finite_within(boards.boom_board_length_m, 1e-3, 5.0), where, "boom_board_length_m", boards.boom_board_length_m, "[0.001, 5] m");
-    require_parameter(finite_within(boards.boom_board_width_m, 1e-3, 1.0), where, "boom_board_width_m", boards.boom_board_width_m, "[0.001, 1] m");
-    require_parameter(finite_within(boards.boom_board_right_m, -10.0, 10.0), where, "boom_board_right_m", boards.boom_board_right_m, "[-10, 10] m");
-    require_parameter(finite_within(boards.nozzle_board_length_m, 1e-3, 1.0), where, "nozzle_board_length_m", boards.nozzle_board_length_m, "[0.001, 1] m");
-    require_parameter(finite_within(boards.nozzle_board_width_m, 1e-3, 1.0), where, "nozzle_board_width_m", boards.nozzle_board_width_m, "[0.001, 1] m");
-    require_parameter(finite_within(boards.nozzle_board_ahead_m, -2.0, 2.0), where, "nozzle_board_ahead_m", boards.nozzle_board_ahead_m, "[-2, 2] m");
-    for (const double x : boards.nozzle_right_m) require_parameter(finite_within(x, -10.0, 10.0), where, "nozzle_right_m[]", x, "[-10, 10] m");
-    return render_scene(crop, pose, &boards, frame_index);
+    return render_scene(crop, pose, nullptr, nullptr, frame_index);
 }
 
 namespace {
@@ -138,8 +125,46 @@ std::optional<Rgb> board_at(const CalibrationBoards& boards, double x, double y)
 
 }  // namespace
 
+std::optional<RgbImage> CameraEmulator::render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                           const CalibrationBoards& boards, std::uint64_t frame_index) const {
+    const std::string where = name_ + ".calibration_boards";
+    require_parameter(finite_within(boards.boom_board_length_m, 1e-3, 5.0), where, "boom_board_length_m", boards.boom_board_length_m, "[0.001, 5] m");
+    require_parameter(finite_within(boards.boom_board_width_m, 1e-3, 1.0), where, "boom_board_width_m", boards.boom_board_width_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.boom_board_right_m, -10.0, 10.0), where, "boom_board_right_m", boards.boom_board_right_m, "[-10, 10] m");
+    require_parameter(finite_within(boards.nozzle_board_length_m, 1e-3, 1.0), where, "nozzle_board_length_m", boards.nozzle_board_length_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.nozzle_board_width_m, 1e-3, 1.0), where, "nozzle_board_width_m", boards.nozzle_board_width_m, "[0.001, 1] m");
+    require_parameter(finite_within(boards.nozzle_board_ahead_m, -2.0, 2.0), where, "nozzle_board_ahead_m", boards.nozzle_board_ahead_m, "[-2, 2] m");
+    for (const double x : boards.nozzle_right_m) require_parameter(finite_within(x, -10.0, 10.0), where, "nozzle_right_m[]", x, "[-10, 10] m");
+    const PlaneOverlay on_boom_plane = [&boards](double x, double y) { return board_at(boards, x, y); };
+    return render_scene(crop, pose, &on_boom_plane, nullptr, frame_index);
+}
+
+std::optional<RgbImage> CameraEmulator::render_chessboard(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                          const Chessboard& board, std::uint64_t frame_index) const {
+    const std::string where = name_ + ".chessboard";
+    require_parameter(board.inner_cols >= 2 && board.inner_cols <= 50, where, "inner_cols", board.inner_cols, "[2, 50]");
+    require_parameter(board.inner_rows >= 2 && board.inner_rows <= 50, where, "inner_rows", board.inner_rows, "[2, 50]");
+    require_parameter(finite_within(board.square_m, 0.005, 0.5), where, "square_m", board.square_m, "[0.005, 0.5] m");
+    require_parameter(finite_within(board.origin_right_m, -10.0, 10.0), where, "origin_right_m", board.origin_right_m, "[-10, 10] m");
+    require_parameter(finite_within(board.origin_ahead_m, -10.0, 10.0), where, "origin_ahead_m", board.origin_ahead_m, "[-10, 10] m");
+    const PlaneOverlay squares = [&board](double x, double y) -> std::optional<Rgb> {
+        // Square indices: square (0, 0) is right-ahead of inner corner (0, 0).
+        const double i = std::floor((x - board.origin_right_m) / board.square_m);
+        const double j = std::floor((y - board.origin_ahead_m) / board.square_m);
+        // The checkered squares run -1 .. inner (one more than the inner corners each way), the margin one more.
+        if (i < -2.0 || j < -2.0 || i > board.inner_cols + 0.0 || j > board.inner_rows + 0.0) return std::nullopt;
+        if (i < -1.0 || j < -1.0 || i > board.inner_cols - 1.0 || j > board.inner_rows - 1.0) return board.white;
+        const bool black = (static_cast<long>(i) + static_cast<long>(j)) % 2 == 0;
+        return black ? board.black : board.white;
+    };
+    return board.on_ground ? render_scene(crop, pose, nullptr, &squares, frame_index)
+                           : render_scene(crop, pose, &squares, nullptr, frame_index);
+}
+
+
 std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
-                                                     const CalibrationBoards* boards, std::uint64_t frame_index) const {
+                                                     const PlaneOverlay* boom_plane, const PlaneOverlay* ground,
+                                                     std::uint64_t frame_index) const {
     if (!finite_within(pose.boom_height_m, 1e-9, 5.0)) {
         std::ostringstream message;
         message << name_ << ": boom height " << pose.boom_height_m << " m is outside (0, 5] m";
@@ -153,14 +178,16 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
     if (faults.dead == DeadCamera::black_frame) return image;
 
     // Each corner ray met with the ground (z = -h in the boom frame), as
-    // east/north offsets from the boom centre's ground point, and (for the
-    // calibration boards) with the boom plane z = 0, in boom-frame x, y.
+    // east/north offsets from the boom centre's ground point (and, for a
+    // ground overlay, in boom-frame x, y), and (for a boom-plane overlay) with
+    // the boom plane z = 0, in boom-frame x, y.
     const Eigen::Matrix3d& axes = camera_.axes_in_boom();
     const Eigen::Vector3d& position = camera_.position_in_boom();
     const Vec2 right_axis = rig::field2d::right_of(pose.heading_deg);
     const Vec2 forward_axis = rig::field2d::forward_of(pose.heading_deg);
     std::vector<Vec2> corner_ground(corner_rays_.size());
-    std::vector<Vec2> corner_boom_plane(boards != nullptr ? corner_rays_.size() : 0);
+    std::vector<Vec2> corner_boom_plane(boom_plane != nullptr ? corner_rays_.size() : 0);
+    std::vector<Vec2> corner_ground_boom(ground != nullptr ? corner_rays_.size() : 0);
     std::vector<std::uint8_t> corner_hits(corner_rays_.size(), 0);
     const double drop = -pose.boom_height_m - position.z();
     for (std::size_t i = 0; i < corner_rays_.size(); ++i) {
@@ -171,7 +198,8 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
         const double x = position.x() + scale * direction.x();
         const double y = position.y() + scale * direction.y();
         corner_ground[i] = x * right_axis + y * forward_axis;
-        if (boards != nullptr) {
+        if (ground != nullptr) corner_ground_boom[i] = Vec2{x, y};
+        if (boom_plane != nullptr) {
             const double to_boom_plane = -position.z() / direction.z();
             corner_boom_plane[i] = Vec2{position.x() + to_boom_plane * direction.x(), position.y() + to_boom_plane * direction.y()};
         }
@@ -215,12 +243,16 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
                         const double fx = (sx + 0.5) / n;
                         Rgb seen = soil;
                         std::optional<Rgb> board;
-                        if (boards != nullptr) {
-                            const Vec2 on_boom_plane = inside_pixel(corner_boom_plane, i00, i10, i01, i11, fx, fy);
-                            board = board_at(*boards, on_boom_plane.east_m, on_boom_plane.north_m);
+                        if (boom_plane != nullptr) {
+                            const Vec2 at = inside_pixel(corner_boom_plane, i00, i10, i01, i11, fx, fy);
+                            board = (*boom_plane)(at.east_m, at.north_m);  // boom-frame x, y in a Vec2
+                        }
+                        if (!board && ground != nullptr) {
+                            const Vec2 at = inside_pixel(corner_ground_boom, i00, i10, i01, i11, fx, fy);
+                            board = (*ground)(at.east_m, at.north_m);
                         }
                         if (board) {
-                            seen = *board;  // the boards are nearer than the ground
+                            seen = *board;  // a board in the boom plane is nearer than the ground; one on the ground covers it
                         } else if (crop.is_plant(pose.boom_centre_ground + inside_pixel(corner_ground, i00, i10, i01, i11, fx, fy))) {
                             seen = plant;
                         }

@@ -19,6 +19,7 @@
 //   colour_cast       a low sun: per-channel gains on top of the lighting
 //   dead              black_frame (a sensor that delivers zeros) or no_frame
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -83,6 +84,25 @@ struct CalibrationBoards {
     rig::camera::Rgb red{190, 40, 40};
 };
 
+// A chessboard for the camera's extrinsic calibration (Sec. 2.2.2: "place a
+// chessboard on the boom plane" for Eq. 5's homography; a second on the
+// ground for Eq. 6). Squares alternate black and white, the square whose
+// corner is `origin` (inner corner (0, 0)) lying diagonally right-ahead of it
+// black; inner corners (i, j) at origin + (i, j) x square_m, i along x
+// (right), j along y (ahead), 0 <= i < inner_cols, 0 <= j < inner_rows; a
+// white margin one square wide all round (so the board's outline gives no
+// X-shaped corner). Sizes assumed (the paper gives none).
+struct Chessboard {
+    int inner_cols = 7;                   // [2, 50]
+    int inner_rows = 5;                   // [2, 50]
+    double square_m = 0.040;              // [0.005, 0.5] m
+    double origin_right_m = 0.0;          // inner corner (0, 0): m right of the boom centre
+    double origin_ahead_m = 0.05;         // ... and ahead of the boom line
+    bool on_ground = false;               // false: in the boom plane; true: on the ground under it
+    rig::camera::Rgb black{25, 25, 25};
+    rig::camera::Rgb white{225, 225, 225};
+};
+
 // Where the boom is (plant truth, e.g. from field2d::SprayerTruth): the ground
 // point under the boom centre, the heading the boom faces, the boom height.
 struct BoomPose {
@@ -111,6 +131,11 @@ public:
     std::optional<rig::camera::RgbImage> render_calibration(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                             const CalibrationBoards& boards, std::uint64_t frame_index) const;
 
+    // A chessboard over the ground at `pose` (the boom plane's rides with the
+    // boom; the ground's lies under it). Throws std::invalid_argument for a bad board.
+    std::optional<rig::camera::RgbImage> render_chessboard(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
+                                                           const Chessboard& board, std::uint64_t frame_index) const;
+
     // The ground point (local east/north) the centre of pixel (u, v) sees with
     // the camera as it truly is (faults included); nullopt if it sees no ground.
     std::optional<rig::field2d::Vec2> ground_seen(const BoomPose& pose, double u, double v) const;
@@ -121,8 +146,11 @@ public:
     const std::string& name() const { return name_; }
 
 private:
+    // What lies on a plane at boom-frame (x, y): a board's colour, or nothing.
+    using PlaneOverlay = std::function<std::optional<rig::camera::Rgb>(double x_m, double y_m)>;
     std::optional<rig::camera::RgbImage> render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
-                                                      const CalibrationBoards* boards, std::uint64_t frame_index) const;
+                                                      const PlaneOverlay* boom_plane, const PlaneOverlay* ground,
+                                                      std::uint64_t frame_index) const;
     CameraEmulatorParams params_;
     std::uint64_t noise_key_;
     std::string name_;

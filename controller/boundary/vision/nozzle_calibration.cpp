@@ -40,6 +40,8 @@ std::optional<Eigen::Vector2d> intersect(const ImageLine& a, const ImageLine& b)
     return a.point + t.x() * a.direction;
 }
 
+// Board pixels this close to the frame's edge mean the board is cut off.
+constexpr int kEdgePx = 2;
 // Boards are 0.3 as wide as long; above this the pixels are not one board.
 constexpr double kMaxSpreadRatio = 0.5;
 
@@ -72,12 +74,18 @@ NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const r
     // The selected pixels' centres, undistorted with the camera's calibration.
     std::vector<Eigen::Vector2d> green_points;
     std::vector<Eigen::Vector2d> red_points;
+    bool green_at_edge = false;
+    bool red_at_edge = false;
     for (int v = 0; v < frame.height; ++v) {
         for (int u = 0; u < frame.width; ++u) {
             const rig::camera::Rgb p = frame.at(u, v);
             const bool is_green = green_index(p) >= result.green_threshold;
             const bool is_red = red_index(p) >= result.red_threshold;
             if (!is_green && !is_red) continue;
+            // A board cut by the frame's edge gives a line through its visible part only.
+            const bool at_edge = u < kEdgePx || v < kEdgePx || u >= frame.width - kEdgePx || v >= frame.height - kEdgePx;
+            green_at_edge = green_at_edge || (is_green && at_edge);
+            red_at_edge = red_at_edge || (is_red && at_edge);
             const auto normalized = rig::camera::undistort_normalized(model.model().distortion,
                                                                       model.pixel_to_distorted_normalized(Eigen::Vector2d(u + 0.5, v + 0.5)));
             if (!normalized) continue;
@@ -93,6 +101,11 @@ NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const r
     if (result.boom_line->spread_ratio > kMaxSpreadRatio) {
         result.problem = "the green pixels do not form one board (spread across / along " +
                          std::to_string(result.boom_line->spread_ratio) + " > 0.5): crop or other green in view?";
+        return result;
+    }
+    if (green_at_edge || red_at_edge) {
+        result.problem = std::string("the ") + (green_at_edge ? "green boom" : "red nozzle") +
+                         " board runs off the frame's edge (camera knocked or mounted elsewhere?)";
         return result;
     }
 

@@ -50,10 +50,11 @@ struct NozzleCalibration {
 // `model`: the camera's intrinsics and distortion (its mounting is not used).
 // `colour_floor`: the least index counted as board whatever Otsu finds
 // (assumed 60: boards are saturated colours, index ~150, soil ~0).
-// Never throws for what the image holds: a frame without the boards, with
-// another number of red boards than `nozzle_count`, or with green or red
-// pixels that do not form a board (spread ratio above 0.5: a crop in view;
-// the paper calibrates on a platform, Fig. 5) gives ok = false and says why.
+// Never throws for what the image holds: a frame without the boards, with a
+// board cut by the frame's edge, with another number of red boards than
+// `nozzle_count`, or with green or red pixels that do not form a board
+// (spread ratio above 0.5: a crop in view; the paper calibrates on a
+// platform, Fig. 5) gives ok = false and says why.
 NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                      std::size_t nozzle_count, int colour_floor = 60);
 
