@@ -150,7 +150,7 @@ int density_survey() {
 // The left camera's frames of a field whose cover changes along travel
 // (bare, sparse, normal in 2 m bands), healthy and with each fault, the
 // controller's ROIs drawn in magenta with the measured D beside the true D;
-// and its calibration frame.
+// and its calibration frames (boards, chessboards).
 int write_frames(const std::string& directory) {
     CropCoverParams params;
     params.default_cover = CoverClass::normal;
@@ -193,6 +193,16 @@ int write_frames(const std::string& directory) {
     bare.default_cover = CoverClass::bare;
     const auto calibration = CameraEmulator(cameras[0].second, 1, 0, "left").render_calibration(CropCoverMap(bare, 1), BoomPose{}, boards, 0);
     rig::camera::write_png(directory + "/left_calibration.png", *calibration);
+    rig::emulators::vision::Chessboard board;
+    board.origin_right_m = config.model.mounting.right_m - 3 * board.square_m;
+    board.origin_ahead_m = 0.10;
+    const CameraEmulator camera(cameras[0].second, 1, 0, "left");
+    rig::camera::write_png(directory + "/left_chessboard_boom_plane.png", *camera.render_chessboard(CropCoverMap(bare, 1), BoomPose{}, board, 0));
+    board.square_m = 0.060;
+    board.origin_right_m = config.model.mounting.right_m - 3 * board.square_m;
+    board.origin_ahead_m = 0.25;
+    board.on_ground = true;
+    rig::camera::write_png(directory + "/left_chessboard_ground.png", *camera.render_chessboard(CropCoverMap(bare, 1), BoomPose{}, board, 0));
     return 0;
 }
 
