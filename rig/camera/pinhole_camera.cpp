@@ -43,6 +43,15 @@ CameraModel seed001_boom_camera(bool right_camera) {
     return model;
 }
 
+std::optional<std::string> frame_size_problem(const RgbImage& frame, const CameraIntrinsics& intrinsics) {
+    if (frame.width == intrinsics.width_px && frame.height == intrinsics.height_px &&
+        frame.bytes.size() == static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height) * 3U) {
+        return std::nullopt;
+    }
+    return "frame " + std::to_string(frame.width) + " x " + std::to_string(frame.height) + " (" + std::to_string(frame.bytes.size()) +
+           " bytes) is not the calibrated " + std::to_string(intrinsics.width_px) + " x " + std::to_string(intrinsics.height_px);
+}
+
 Eigen::Vector2d distort_normalized(const BrownConradyDistortion& d, const Eigen::Vector2d& p) {
     const double x = p.x();
     const double y = p.y();

@@ -26,6 +26,8 @@
 
 #include <Eigen/Dense>
 
+#include "rig/camera/rgb_image.h"
+
 namespace rig::camera {
 
 struct CameraIntrinsics {
@@ -86,6 +88,10 @@ CameraModel seed001_boom_camera(bool right_camera);
 // Throws std::invalid_argument "<where>.<field>: <what>" for the first value
 // out of the bounds given beside each field.
 void validate(const CameraModel& model, const std::string& where);
+
+// Why a frame cannot be this camera's (its size or byte count differ from the
+// intrinsics' resolution), naming both; nullopt when it can.
+std::optional<std::string> frame_size_problem(const RgbImage& frame, const CameraIntrinsics& intrinsics);
 
 // Brown-Conrady forward (above).
 Eigen::Vector2d distort_normalized(const BrownConradyDistortion& distortion, const Eigen::Vector2d& undistorted);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "controller/boundary/vision/image_ops.h"
 
@@ -33,14 +34,20 @@ Eigen::Vector2d apply(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
     return {q.x() / q.z(), q.y() / q.z()};
 }
 
-// Hartley's normalisation: centroid to the origin, mean distance sqrt(2).
-Eigen::Matrix3d normalising(const std::vector<Eigen::Vector2d>& points) {
-    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-    for (const Eigen::Vector2d& p : points) centroid += p;
+// The points' centroid and their mean distance from it (Hartley's normalisation).
+template <int N>
+std::pair<Eigen::Matrix<double, N, 1>, double> centroid_and_spread(const std::vector<Eigen::Matrix<double, N, 1>>& points) {
+    Eigen::Matrix<double, N, 1> centroid = Eigen::Matrix<double, N, 1>::Zero();
+    for (const auto& p : points) centroid += p;
     centroid /= static_cast<double>(points.size());
     double mean_distance = 0.0;
-    for (const Eigen::Vector2d& p : points) mean_distance += (p - centroid).norm();
-    mean_distance /= static_cast<double>(points.size());
+    for (const auto& p : points) mean_distance += (p - centroid).norm();
+    return {centroid, mean_distance / static_cast<double>(points.size())};
+}
+
+// Hartley's normalisation: centroid to the origin, mean distance sqrt(2).
+Eigen::Matrix3d normalising(const std::vector<Eigen::Vector2d>& points) {
+    const auto [centroid, mean_distance] = centroid_and_spread(points);
     const double scale = mean_distance > 0.0 ? std::sqrt(2.0) / mean_distance : 1.0;
     Eigen::Matrix3d t;
     t << scale, 0.0, -scale * centroid.x(), 0.0, scale, -scale * centroid.y(), 0.0, 0.0, 1.0;
@@ -78,11 +85,8 @@ Eigen::Matrix3d fit_homography(const std::vector<Eigen::Vector2d>& from, const s
 ChessboardView find_chessboard(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                const ChessboardPlacement& placement) {
     ChessboardView view;
-    const rig::camera::CameraIntrinsics& k = model.model().intrinsics;
-    if (frame.width != k.width_px || frame.height != k.height_px ||
-        frame.bytes.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height) * 3U) {
-        view.problem = "frame " + std::to_string(frame.width) + " x " + std::to_string(frame.height) + " is not the calibrated " +
-                       std::to_string(k.width_px) + " x " + std::to_string(k.height_px);
+    if (const auto problem = rig::camera::frame_size_problem(frame, model.model().intrinsics)) {
+        view.problem = *problem;
         return view;
     }
     if (placement.inner_cols < 2 || placement.inner_rows < 2 || !(placement.square_m > 0.0)) {
@@ -335,12 +339,7 @@ rig::camera::CameraMounting mounting_from_points(const rig::camera::CameraIntrin
     }
     // Normalise the 3-D points (centroid to 0, mean distance sqrt(3)); the
     // image points become normalised camera coordinates through K.
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : boom_points) centroid += p;
-    centroid /= static_cast<double>(boom_points.size());
-    double mean_distance = 0.0;
-    for (const Eigen::Vector3d& p : boom_points) mean_distance += (p - centroid).norm();
-    mean_distance /= static_cast<double>(boom_points.size());
+    const auto [centroid, mean_distance] = centroid_and_spread(boom_points);
     const double s = std::sqrt(3.0) / mean_distance;
     Eigen::MatrixXd a(2 * boom_points.size(), 12);
     for (std::size_t i = 0; i < boom_points.size(); ++i) {

@@ -52,11 +52,8 @@ int threshold_of(const Histogram& histogram, int floor) { return std::max(otsu_t
 NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                      std::size_t nozzle_count, int colour_floor) {
     NozzleCalibration result;
-    const rig::camera::CameraIntrinsics& k = model.model().intrinsics;
-    if (frame.width != k.width_px || frame.height != k.height_px ||
-        frame.bytes.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height) * 3U) {
-        result.problem = "frame " + std::to_string(frame.width) + " x " + std::to_string(frame.height) + " is not the calibrated " +
-                         std::to_string(k.width_px) + " x " + std::to_string(k.height_px);
+    if (const auto problem = rig::camera::frame_size_problem(frame, model.model().intrinsics)) {
+        result.problem = *problem;
         return result;
     }
     Histogram green{};

@@ -210,13 +210,9 @@ FrameDensities CameraVision::measure(const rig::camera::RgbImage* frame, double 
         result.detail = camera_.name + ": no frame from the camera";
         return result;
     }
-    const rig::camera::CameraIntrinsics& k = model_.model().intrinsics;
-    if (frame->width != k.width_px || frame->height != k.height_px ||
-        frame->bytes.size() != static_cast<std::size_t>(k.width_px) * static_cast<std::size_t>(k.height_px) * 3U) {
+    if (const auto problem = rig::camera::frame_size_problem(*frame, model_.model().intrinsics)) {
         result.status = FrameStatus::wrong_size;
-        result.detail = camera_.name + ": frame " + std::to_string(frame->width) + " x " + std::to_string(frame->height) +
-                        " (" + std::to_string(frame->bytes.size()) + " bytes), calibrated for " + std::to_string(k.width_px) +
-                        " x " + std::to_string(k.height_px);
+        result.detail = camera_.name + ": " + *problem;
         return result;
     }
     double byte_sum = 0.0;
