@@ -34,6 +34,17 @@ Eigen::Vector2d apply(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
     return {q.x() / q.z(), q.y() / q.z()};
 }
 
+// The DLT's solution: the right singular vector of A's smallest singular
+// value. Throws std::invalid_argument `degenerate` when the next smallest is
+// also (near) zero: the points do not fix the solution.
+Eigen::VectorXd null_vector(const Eigen::MatrixXd& a, const char* degenerate) {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const Eigen::Index n = a.cols();
+    if (sv(n - 2) < 1e-9 * sv(0)) throw std::invalid_argument(degenerate);
+    return svd.matrixV().col(n - 1);
+}
+
 // The points' centroid and their mean distance from it (Hartley's normalisation).
 template <int N>
 std::pair<Eigen::Matrix<double, N, 1>, double> centroid_and_spread(const std::vector<Eigen::Matrix<double, N, 1>>& points) {
@@ -71,10 +82,7 @@ Eigen::Matrix3d fit_homography(const std::vector<Eigen::Vector2d>& from, const s
         a.row(r) << p.x(), p.y(), 1.0, 0.0, 0.0, 0.0, -q.x() * p.x(), -q.x() * p.y(), -q.x();
         a.row(r + 1) << 0.0, 0.0, 0.0, p.x(), p.y(), 1.0, -q.y() * p.x(), -q.y() * p.y(), -q.y();
     }
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
-    const Eigen::VectorXd& sv = svd.singularValues();
-    if (sv(7) < 1e-9 * sv(0)) throw std::invalid_argument("fit_homography: degenerate points (collinear or repeated)");
-    const Eigen::VectorXd h = svd.matrixV().col(8);
+    const Eigen::VectorXd h = null_vector(a, "fit_homography: degenerate points (collinear or repeated)");
     Eigen::Matrix3d normalised;
     normalised << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
     Eigen::Matrix3d result = t_to.inverse() * normalised * t_from;
@@ -350,10 +358,7 @@ rig::camera::CameraMounting mounting_from_points(const rig::camera::CameraIntrin
         a.row(r) << p.x(), p.y(), p.z(), 1.0, 0.0, 0.0, 0.0, 0.0, -x * p.x(), -x * p.y(), -x * p.z(), -x;
         a.row(r + 1) << 0.0, 0.0, 0.0, 0.0, p.x(), p.y(), p.z(), 1.0, -y * p.x(), -y * p.y(), -y * p.z(), -y;
     }
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
-    const Eigen::VectorXd& sv = svd.singularValues();
-    if (sv(10) < 1e-9 * sv(0)) throw std::invalid_argument("mounting_from_points: degenerate points (all on one plane or a line)");
-    const Eigen::VectorXd v = svd.matrixV().col(11);
+    const Eigen::VectorXd v = null_vector(a, "mounting_from_points: degenerate points (all on one plane or a line)");
     // [M | m] on normalised points: x ~ M p' + m with p' = s (P - c), so in
     // boom coordinates x ~ (s M) P + (m - s M c).
     Eigen::Matrix3d m_normalised;
