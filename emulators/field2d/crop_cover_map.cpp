@@ -1,0 +1,295 @@
+#include "emulators/field2d/crop_cover_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "emulators/field2d/counter_hash.h"
+#include "rig/camera/parameter_check.h"
+
+namespace rig::field2d {
+
+namespace {
+
+// Tiles of 256 x 256 cells (0.256 m): a camera's view (about 2.6 x 0.9 m of
+// ground) touches some 40 of them.
+constexpr int kTileShift = 8;
+constexpr int kTileCells = 1 << kTileShift;
+constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
+// Beyond this many cached tiles (64 KiB each) the cache starts again: tiles
+// are pure functions of the seed, so dropping them changes nothing but time.
+constexpr std::size_t kMaxCachedTiles = 1024;
+// Plants are drawn per row cell of this length along the row.
+constexpr double kRowCellM = 0.25;
+
+// Poisson by inversion of its CDF (mean at most 250 here, so exp(-mean) stays a normal double).
+int poisson(HashStream& stream, double mean) {
+    const double u = stream.uniform01();
+    double probability = std::exp(-mean);
+    double cumulative = probability;
+    int count = 0;
+    while (u > cumulative) {
+        ++count;
+        probability *= mean / count;
+        cumulative += probability;
+        if (probability < 1e-300 && count > mean) break;  // the tail is exhausted (rounding left u above 1 - eps)
+    }
+    return count;
+}
+
+std::int64_t floor_to_int(double value) {
+    const auto truncated = static_cast<std::int64_t>(value);
+    return static_cast<double>(truncated) > value ? truncated - 1 : truncated;
+}
+
+std::uint64_t tile_key(std::int64_t east, std::int64_t north) {
+    return (static_cast<std::uint64_t>(east) << 32) ^ (static_cast<std::uint64_t>(north) & 0xffffffffULL);
+}
+
+// The crop's parameters are checked like the cameras' (one message shape).
+void require(bool ok, const char* field, double value, const char* bounds) {
+    rig::camera::require_parameter(ok, "crop", field, value, bounds);
+}
+using rig::camera::finite_within;
+
+// Squared distance from p to the segment a-b.
+double segment_distance_sq(double px, double py, double ax, double ay, double bx, double by) {
+    const double dx = bx - ax;
+    const double dy = by - ay;
+    const double length_sq = dx * dx + dy * dy;
+    double t = length_sq > 0.0 ? ((px - ax) * dx + (py - ay) * dy) / length_sq : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const double ex = px - (ax + t * dx);
+    const double ey = py - (ay + t * dy);
+    return ex * ex + ey * ey;
+}
+
+bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+    const double d1 = cross(b - a, c - a);
+    const double d2 = cross(b - a, d - a);
+    const double d3 = cross(d - c, a - c);
+    const double d4 = cross(d - c, b - c);
+    return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
+}
+
+// Crossing-number test (a point on an edge may fall either way; only cell
+// centres are tested, and a 1 mm cell on the edge of a 0.24 m^2 ROI is noise).
+bool inside_quad(const std::array<Vec2, 4>& q, double x, double y) {
+    bool inside = false;
+    for (std::size_t i = 0, j = 3; i < 4; j = i++) {
+        const Vec2 a = q[i];
+        const Vec2 b = q[j];
+        if ((a.north_m > y) != (b.north_m > y)) {
+            const double x_at = a.east_m + (y - a.north_m) * (b.east_m - a.east_m) / (b.north_m - a.north_m);
+            if (x < x_at) inside = !inside;
+        }
+    }
+    return inside;
+}
+
+}  // namespace
+
+struct CropCoverMap::Tile {
+    std::vector<std::uint8_t> plant = std::vector<std::uint8_t>(static_cast<std::size_t>(kTileCells) * kTileCells, 0);
+};
+
+const char* cover_class_name(CoverClass cover) {
+    switch (cover) {
+        case CoverClass::bare: return "bare";
+        case CoverClass::sparse: return "sparse";
+        case CoverClass::normal: return "normal";
+    }
+    return "unknown";
+}
+
+void validate(const CropCoverParams& p) {
+    require(finite_within(p.row_spacing_m, 0.05, 1.0), "row_spacing_m", p.row_spacing_m, "[0.05, 1.0] m");
+    require(finite_within(p.row_bearing_deg, 0.0, 360.0) && p.row_bearing_deg < 360.0, "row_bearing_deg", p.row_bearing_deg, "[0, 360) deg");
+    require(finite_within(p.row_offset_m, -p.row_spacing_m, p.row_spacing_m), "row_offset_m", p.row_offset_m, "[-row_spacing_m, row_spacing_m]");
+    require(finite_within(p.row_scatter_m, 0.0, 0.1), "row_scatter_m", p.row_scatter_m, "[0, 0.1] m");
+    require(finite_within(p.normal_plants_per_m, 0.0, 1000.0), "normal_plants_per_m", p.normal_plants_per_m, "[0, 1000] 1/m");
+    require(finite_within(p.sparse_plants_per_m, 0.0, 1000.0), "sparse_plants_per_m", p.sparse_plants_per_m, "[0, 1000] 1/m");
+    require(finite_within(p.plant_height_min_m, 1e-9, 1.0), "plant_height_min_m", p.plant_height_min_m, "(0, 1] m");
+    require(finite_within(p.plant_height_max_m, p.plant_height_min_m, 1.0), "plant_height_max_m", p.plant_height_max_m, "[plant_height_min_m, 1] m");
+    require(p.leaves_min >= 1 && p.leaves_min <= 20, "leaves_min", p.leaves_min, "[1, 20]");
+    require(p.leaves_max >= p.leaves_min && p.leaves_max <= 20, "leaves_max", p.leaves_max, "[leaves_min, 20]");
+    require(finite_within(p.leaf_length_per_height_min, 1e-9, 5.0), "leaf_length_per_height_min", p.leaf_length_per_height_min, "(0, 5]");
+    require(finite_within(p.leaf_length_per_height_max, p.leaf_length_per_height_min, 5.0), "leaf_length_per_height_max",
+            p.leaf_length_per_height_max, "[leaf_length_per_height_min, 5]");
+    require(finite_within(p.leaf_width_m, 0.001, 0.05), "leaf_width_m", p.leaf_width_m, "[0.001, 0.05] m");
+}
+
+CropCoverMap::CropCoverMap(CropCoverParams params, std::uint64_t seed) : params_(std::move(params)), seed_(seed) {
+    validate(params_);
+}
+CropCoverMap::~CropCoverMap() = default;
+CropCoverMap::CropCoverMap(CropCoverMap&&) noexcept = default;
+CropCoverMap& CropCoverMap::operator=(CropCoverMap&&) noexcept = default;
+
+CoverClass CropCoverMap::cover_class_at(Vec2 ground) const {
+    for (auto patch = params_.patches.rbegin(); patch != params_.patches.rend(); ++patch) {
+        if (patch->area.contains(ground)) return patch->cover;
+    }
+    return params_.default_cover;
+}
+
+bool CropCoverMap::is_plant(Vec2 ground) const {
+    // The renderer asks this four times a pixel: std::floor is a libm call on
+    // the baseline x86-64 target, so the floors are done by truncation.
+    // (Within 1000 km of the origin: a field, and far inside int64 cells.)
+    if (!(std::abs(ground.east_m) < 1e6 && std::abs(ground.north_m) < 1e6)) {
+        throw std::invalid_argument("crop is_plant: (" + std::to_string(ground.east_m) + ", " + std::to_string(ground.north_m) +
+                                    ") m is not a ground point within 1000 km of the origin");
+    }
+    const std::int64_t east = floor_to_int(ground.east_m / kCellM);
+    const std::int64_t north = floor_to_int(ground.north_m / kCellM);
+    // Floor division into tiles (an arithmetic shift: kTileCells is 2^8) and cells within them.
+    const std::int64_t tile_east = east >> kTileShift;
+    const std::int64_t tile_north = north >> kTileShift;
+    const Tile& t = tile(tile_east, tile_north);
+    const auto i = static_cast<std::size_t>(east - tile_east * kTileCells);
+    const auto j = static_cast<std::size_t>(north - tile_north * kTileCells);
+    return t.plant[j * kTileCells + i] != 0;
+}
+
+const CropCoverMap::Tile& CropCoverMap::tile(std::int64_t tile_east, std::int64_t tile_north) const {
+    const std::uint64_t key = tile_key(tile_east, tile_north);
+    if (last_tile_ != nullptr && key == last_key_) return *last_tile_;
+    auto found = tiles_.find(key);
+    if (found == tiles_.end()) {
+        if (tiles_.size() >= kMaxCachedTiles) tiles_.clear();
+        auto fresh = std::make_unique<Tile>();
+        rasterise(*fresh, tile_east, tile_north);
+        found = tiles_.emplace(key, std::move(fresh)).first;
+    }
+    last_tile_ = found->second.get();
+    last_key_ = key;
+    return *last_tile_;
+}
+
+void CropCoverMap::rasterise(Tile& tile, std::int64_t tile_east, std::int64_t tile_north) const {
+    const CropCoverParams& p = params_;
+    const Vec2 along_axis = forward_of(p.row_bearing_deg);
+    const Vec2 across_axis = right_of(p.row_bearing_deg);
+    const double east0 = static_cast<double>(tile_east) * kTileM;
+    const double north0 = static_cast<double>(tile_north) * kTileM;
+    // How far from its row cell and row line a leaf can reach.
+    const double reach = p.plant_height_max_m * p.leaf_length_per_height_max + p.leaf_width_m + p.row_scatter_m;
+
+    double across_min = 1e300, across_max = -1e300, along_min = 1e300, along_max = -1e300;
+    for (const Vec2 corner : {Vec2{east0, north0}, Vec2{east0 + kTileM, north0}, Vec2{east0, north0 + kTileM},
+                              Vec2{east0 + kTileM, north0 + kTileM}}) {
+        const double across = dot(corner, across_axis) - p.row_offset_m;
+        const double along = dot(corner, along_axis);
+        across_min = std::min(across_min, across);
+        across_max = std::max(across_max, across);
+        along_min = std::min(along_min, along);
+        along_max = std::max(along_max, along);
+    }
+    const auto row_first = static_cast<std::int64_t>(std::floor((across_min - reach) / p.row_spacing_m));
+    const auto row_last = static_cast<std::int64_t>(std::ceil((across_max + reach) / p.row_spacing_m));
+    const auto cell_first = static_cast<std::int64_t>(std::floor((along_min - reach) / kRowCellM));
+    const auto cell_last = static_cast<std::int64_t>(std::floor((along_max + reach) / kRowCellM));
+
+    // Every class's plants are drawn at the densest rate and thinned by the
+    // class under each plant, so a patch edge cuts the row where it lies.
+    const double densest = std::max(p.normal_plants_per_m, p.sparse_plants_per_m);
+    const double half_width = 0.5 * p.leaf_width_m;
+    for (std::int64_t row = row_first; row <= row_last; ++row) {
+        for (std::int64_t cell = cell_first; cell <= cell_last; ++cell) {
+            HashStream stream(hash_key(seed_, static_cast<std::uint64_t>(row), static_cast<std::uint64_t>(cell)));
+            const int candidates = poisson(stream, densest * kRowCellM);
+            for (int plant = 0; plant < candidates; ++plant) {
+                // Draw every number of a plant whether it is kept or not, so a
+                // patch changes only its own plants.
+                const double along = (static_cast<double>(cell) + stream.uniform01()) * kRowCellM;
+                const double across = static_cast<double>(row) * p.row_spacing_m + p.row_offset_m +
+                                      (2.0 * stream.uniform01() - 1.0) * p.row_scatter_m;
+                const double keep = stream.uniform01();
+                const double height = p.plant_height_min_m + stream.uniform01() * (p.plant_height_max_m - p.plant_height_min_m);
+                const int leaves = p.leaves_min + std::min(p.leaves_max - p.leaves_min,
+                                                           static_cast<int>(stream.uniform01() * (p.leaves_max - p.leaves_min + 1)));
+                const Vec2 base = along * along_axis + across * across_axis;
+                double rate = 0.0;
+                switch (cover_class_at(base)) {
+                    case CoverClass::bare: rate = 0.0; break;
+                    case CoverClass::sparse: rate = p.sparse_plants_per_m; break;
+                    case CoverClass::normal: rate = p.normal_plants_per_m; break;
+                }
+                const bool kept = densest > 0.0 && keep < rate / densest;
+                for (int leaf = 0; leaf < leaves; ++leaf) {
+                    const double azimuth = 2.0 * std::numbers::pi * stream.uniform01();
+                    const double length = height * (p.leaf_length_per_height_min +
+                                                    stream.uniform01() * (p.leaf_length_per_height_max - p.leaf_length_per_height_min));
+                    if (!kept) continue;
+                    const double bx = base.east_m - east0;
+                    const double by = base.north_m - north0;
+                    const double tx = bx + length * std::cos(azimuth);
+                    const double ty = by + length * std::sin(azimuth);
+                    const int i_first = std::max(0, static_cast<int>(std::floor((std::min(bx, tx) - half_width) / kCellM)));
+                    const int i_last = std::min(kTileCells - 1, static_cast<int>(std::floor((std::max(bx, tx) + half_width) / kCellM)));
+                    const int j_first = std::max(0, static_cast<int>(std::floor((std::min(by, ty) - half_width) / kCellM)));
+                    const int j_last = std::min(kTileCells - 1, static_cast<int>(std::floor((std::max(by, ty) + half_width) / kCellM)));
+                    for (int j = j_first; j <= j_last; ++j) {
+                        const double cy = (j + 0.5) * kCellM;
+                        for (int i = i_first; i <= i_last; ++i) {
+                            const double cx = (i + 0.5) * kCellM;
+                            if (segment_distance_sq(cx, cy, bx, by, tx, ty) <= half_width * half_width) {
+                                tile.plant[static_cast<std::size_t>(j) * kTileCells + static_cast<std::size_t>(i)] = 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+double CropCoverMap::cover_fraction(const std::array<Vec2, 4>& corners) const {
+    double east_min = 1e300, east_max = -1e300, north_min = 1e300, north_max = -1e300;
+    for (std::size_t i = 0; i < 4; ++i) {
+        if (!std::isfinite(corners[i].east_m) || !std::isfinite(corners[i].north_m)) {
+            throw std::invalid_argument("crop cover_fraction: corner " + std::to_string(i) + " is not finite");
+        }
+        east_min = std::min(east_min, corners[i].east_m);
+        east_max = std::max(east_max, corners[i].east_m);
+        north_min = std::min(north_min, corners[i].north_m);
+        north_max = std::max(north_max, corners[i].north_m);
+    }
+    if (segments_cross(corners[0], corners[1], corners[2], corners[3]) ||
+        segments_cross(corners[1], corners[2], corners[3], corners[0])) {
+        throw std::invalid_argument("crop cover_fraction: the quadrilateral's edges cross (corners out of order)");
+    }
+    if ((east_max - east_min) * (north_max - north_min) > 100.0) {
+        throw std::invalid_argument("crop cover_fraction: the quadrilateral spans more than 100 m^2 (an ROI is 0.24 m^2)");
+    }
+    const auto i_first = static_cast<std::int64_t>(std::floor(east_min / kCellM));
+    const auto i_last = static_cast<std::int64_t>(std::floor(east_max / kCellM));
+    const auto j_first = static_cast<std::int64_t>(std::floor(north_min / kCellM));
+    const auto j_last = static_cast<std::int64_t>(std::floor(north_max / kCellM));
+    std::int64_t inside = 0;
+    std::int64_t plant = 0;
+    for (std::int64_t j = j_first; j <= j_last; ++j) {
+        const double y = (static_cast<double>(j) + 0.5) * kCellM;
+        for (std::int64_t i = i_first; i <= i_last; ++i) {
+            const double x = (static_cast<double>(i) + 0.5) * kCellM;
+            if (!inside_quad(corners, x, y)) continue;
+            ++inside;
+            if (is_plant(Vec2{x, y})) ++plant;
+        }
+    }
+    if (inside == 0) throw std::invalid_argument("crop cover_fraction: the quadrilateral holds no 1 mm cell centre");
+    return static_cast<double>(plant) / static_cast<double>(inside);
+}
+
+std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m, double width_m,
+                                      double near_m, double depth_m) {
+    auto at = [&](double right, double ahead) { return body_to_field(boom_centre_ground, heading_deg, right, ahead); };
+    const double half = 0.5 * width_m;
+    return {at(nozzle_right_m - half, near_m), at(nozzle_right_m + half, near_m), at(nozzle_right_m + half, near_m + depth_m),
+            at(nozzle_right_m - half, near_m + depth_m)};
+}
+
+}  // namespace rig::field2d

@@ -1,0 +1,124 @@
+#pragma once
+// Seed 001's crop truth: which ground points are wheat and which are soil
+// (plant truth, local east-north frame of local_frame.h). The paper sprays
+// wheat "40-80 mm" tall (Sec. 5.1, November, early growth), classes areas as
+// sparse (computed cover D < 40 %) or normal (> 40 %) (Sec. 5.2) and sprays
+// nothing where there are no plants (Sec. 1.1); it describes no plant layout.
+//
+// The model: drilled rows at a fixed spacing and bearing; along each row,
+// plants at the positions of a Poisson process (seeds scattered a little
+// across the row); each plant a few leaves, each a straight strip ("capsule")
+// from the plant's base outwards at a random azimuth, as a seedling looks from
+// above. How many plants a metre of row holds depends on the cover class of
+// the ground under the plant: bare soil (none), sparse or normal; patches of
+// each are polygons laid over a default class.
+//
+// Truth is a raster of 1 mm cells: a cell is plant when its centre lies on a
+// leaf. is_plant() reads that raster and cover_fraction() counts its cells, so
+// the two agree exactly; 1 mm is an eighth of a leaf's width and a third of a
+// camera pixel's footprint on the ground (about 2.5 mm at 1280 x 720 from
+// 1.5 m), fine enough to be ground truth for both.
+//
+// Reproducible: every plant is drawn from a counter-based hash of (seed, row,
+// row cell), so the field is the same whatever order it is looked at in and
+// needs no storage up front; the raster is built in tiles on first use and
+// cached (the class is therefore not safe to share between threads).
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "emulators/field2d/polygon.h"
+#include "emulators/field2d/vec2.h"
+
+namespace rig::field2d {
+
+enum class CoverClass { bare, sparse, normal };
+const char* cover_class_name(CoverClass cover);
+
+struct CoverPatch {
+    Polygon area;
+    CoverClass cover = CoverClass::normal;
+};
+
+struct CropCoverParams {
+    // Rows. The paper gives no row spacing: 0.20 m assumed (a common drill
+    // spacing for winter wheat on the North China Plain, 15-25 cm).
+    double row_spacing_m = 0.20;             // [0.05, 1.0] m
+    double row_bearing_deg = 0.0;            // [0, 360) deg, compass; assumed: rows run north (a case sets it)
+    double row_offset_m = 0.0;               // [-row_spacing_m, row_spacing_m] m: row 0's distance right of the origin
+    double row_scatter_m = 0.015;            // [0, 0.1] m: seeds land up to this far either side of the row (assumed)
+    // Plants per metre of row, by class (assumed: 100 / m at 0.20 m is 500
+    // plants / m^2, a dense winter-wheat stand; 30 / m for sparse). With the
+    // leaf sizes below they give a true cover of about 56 % (51-61 % per
+    // 60 x 40 cm ROI) and 27 % (16-33 %), either side of Sec. 5.2's 40 %
+    // sparse/normal split (docs/seed001-vision.md).
+    double normal_plants_per_m = 100.0;      // [0, 1000] 1/m
+    double sparse_plants_per_m = 30.0;       // [0, 1000] 1/m
+    // Plant height (Sec. 5.1: wheat 40-80 mm), uniform between the two.
+    double plant_height_min_m = 0.040;       // (0, 1] m
+    double plant_height_max_m = 0.080;       // [min, 1] m
+    // Leaves (assumed; two- to three-leaf seedlings): their number uniform in
+    // [min, max], their length seen from above a uniform multiple of the
+    // plant's height (seedling blades arch over, so they reach further than
+    // the plant stands tall), their width constant.
+    int leaves_min = 3;                      // [1, 20]
+    int leaves_max = 5;                      // [leaves_min, 20]
+    double leaf_length_per_height_min = 1.0; // (0, 5]
+    double leaf_length_per_height_max = 1.5; // [min, 5]
+    double leaf_width_m = 0.008;             // [0.001, 0.05] m
+    CoverClass default_cover = CoverClass::normal;  // outside every patch
+    std::vector<CoverPatch> patches;         // a later patch wins where two overlap
+};
+
+// Throws std::invalid_argument "crop.<field>: <what>".
+void validate(const CropCoverParams& params);
+
+class CropCoverMap {
+public:
+    // The truth raster's cell size.
+    static constexpr double kCellM = 0.001;
+
+    // Throws std::invalid_argument as validate() does.
+    CropCoverMap(CropCoverParams params, std::uint64_t seed);
+    ~CropCoverMap();
+    CropCoverMap(CropCoverMap&&) noexcept;
+    CropCoverMap& operator=(CropCoverMap&&) noexcept;
+
+    // True where the 1 mm cell holding `ground` is plant. Throws
+    // std::invalid_argument for a non-finite point or one 1000 km or more away.
+    bool is_plant(Vec2 ground) const;
+    // The class of the ground at a point (the last patch holding it, else the default).
+    CoverClass cover_class_at(Vec2 ground) const;
+    // True cover D (0..1) of a ground quadrilateral (corners in order around
+    // it, either sense): the share of the 1 mm cells whose centres lie inside
+    // that are plant. Throws std::invalid_argument for a non-finite corner,
+    // edges that cross, or a quadrilateral holding no cell centre.
+    double cover_fraction(const std::array<Vec2, 4>& corners) const;
+
+    const CropCoverParams& params() const { return params_; }
+    std::uint64_t seed() const { return seed_; }
+    std::size_t cached_tile_count() const { return tiles_.size(); }
+
+private:
+    struct Tile;
+    const Tile& tile(std::int64_t tile_east, std::int64_t tile_north) const;
+    void rasterise(Tile& tile, std::int64_t tile_east, std::int64_t tile_north) const;
+
+    CropCoverParams params_;
+    std::uint64_t seed_;
+    mutable std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
+    mutable const Tile* last_tile_ = nullptr;
+    mutable std::uint64_t last_key_ = 0;
+};
+
+// Sec. 2.1's ground ROI of a nozzle, from the plant's truth: w across centred
+// on the nozzle, from `near_m` to `near_m + depth_m` ahead of its ground point,
+// square to the boom; corners near-left, near-right, far-right, far-left (the
+// order of cover_fraction and of the controller's NozzleRoi). Defaults: Sec.
+// 2.1's w = 600 mm, h1 = 200 mm, h2 = 400 mm.
+std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m,
+                                      double width_m = 0.600, double near_m = 0.200, double depth_m = 0.400);
+
+}  // namespace rig::field2d

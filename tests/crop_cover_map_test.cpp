@@ -1,0 +1,158 @@
+// Seed 001's crop truth (emulators/field2d/crop_cover_map.h): reproducible
+// from its seed, rows where they are declared, the cover classes' true cover,
+// patches, and cover_fraction against a direct count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "emulators/field2d/crop_cover_map.h"
+
+namespace {
+
+using namespace rig::field2d;
+
+std::array<Vec2, 4> rectangle(double east, double north, double width, double depth) {
+    return {Vec2{east, north}, Vec2{east + width, north}, Vec2{east + width, north + depth}, Vec2{east, north + depth}};
+}
+
+CropCoverParams of_class(CoverClass cover) {
+    CropCoverParams params;
+    params.default_cover = cover;
+    return params;
+}
+
+TEST(CropCoverMap, SameSeedSameFieldWhateverTheOrderOfLooking) {
+    const CropCoverMap a(CropCoverParams{}, 7);
+    const CropCoverMap b(CropCoverParams{}, 7);
+    const CropCoverMap other(CropCoverParams{}, 8);
+    // b is looked at far away first, so its tiles are built in another order.
+    (void)b.cover_fraction(rectangle(40.0, -30.0, 0.6, 0.4));
+    int differ_from_other = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const Vec2 p{std::fmod(0.037 * i, 3.0) - 1.5, 0.00071 * i};  // 3 m x 2.8 m
+        ASSERT_EQ(a.is_plant(p), b.is_plant(p)) << p.east_m << ", " << p.north_m;
+        if (a.is_plant(p) != other.is_plant(p)) ++differ_from_other;
+    }
+    EXPECT_GT(differ_from_other, 400);  // another seed is another field
+    EXPECT_DOUBLE_EQ(a.cover_fraction(rectangle(1.0, 2.0, 0.6, 0.4)), b.cover_fraction(rectangle(1.0, 2.0, 0.6, 0.4)));
+}
+
+TEST(CropCoverMap, ClassesGiveTheirCoverAroundSec52sSplit) {
+    // Sec. 5.2 splits sparse (D < 40 %) from normal (> 40 %) on 60 x 40 cm
+    // frames; the defaults put every such frame of a class on its side of
+    // 40 % (measured: normal 51-61 %, sparse 16-33 %, docs/seed001-vision.md).
+    for (const std::uint64_t seed : {1ULL, 2ULL}) {
+        const CropCoverMap bare(of_class(CoverClass::bare), seed);
+        const CropCoverMap sparse(of_class(CoverClass::sparse), seed);
+        const CropCoverMap normal(of_class(CoverClass::normal), seed);
+        for (int k = 0; k < 6; ++k) {
+            const auto roi = rectangle(0.7 * k - 2.0, 1.3 * k, 0.6, 0.4);
+            EXPECT_EQ(bare.cover_fraction(roi), 0.0);
+            const double d_sparse = sparse.cover_fraction(roi);
+            const double d_normal = normal.cover_fraction(roi);
+            EXPECT_GT(d_sparse, 0.08);
+            EXPECT_LT(d_sparse, 0.38);
+            EXPECT_GT(d_normal, 0.45);
+            EXPECT_LT(d_normal, 0.70);
+        }
+    }
+}
+
+TEST(CropCoverMap, PlantsStayNearTheirRows) {
+    // Rows run north every 0.20 m from east = 0. A leaf reaches at most
+    // 80 mm x 1.5 + 8 mm + 15 mm scatter = 143 mm from its row's line, so a
+    // 4 cm band midway between rows (0.08-0.12 m from each) still gets
+    // leaves, but much less often than the band on a row.
+    const CropCoverMap normal(CropCoverParams{}, 3);
+    const double on_row = normal.cover_fraction(rectangle(-0.02, 0.0, 0.04, 3.0));
+    const double between_rows = normal.cover_fraction(rectangle(0.08, 0.0, 0.04, 3.0));
+    EXPECT_GT(on_row, 0.8);
+    EXPECT_LT(between_rows, 0.6 * on_row);
+    // Turning the rows to run east moves the dense band.
+    CropCoverParams east_rows;
+    east_rows.row_bearing_deg = 90.0;
+    const CropCoverMap turned(east_rows, 3);
+    EXPECT_GT(turned.cover_fraction(rectangle(0.0, -0.02, 3.0, 0.04)), 0.8);
+}
+
+TEST(CropCoverMap, PatchesSetTheClassAndTheLastWins) {
+    CropCoverParams params;
+    params.default_cover = CoverClass::normal;
+    params.patches.push_back({Polygon({{0, 0}, {4, 0}, {4, 4}, {0, 4}}, "bare square"), CoverClass::bare});
+    params.patches.push_back({Polygon({{2, 2}, {4, 2}, {4, 4}, {2, 4}}, "sparse corner"), CoverClass::sparse});
+    const CropCoverMap map(params, 5);
+    EXPECT_EQ(map.cover_class_at({1, 1}), CoverClass::bare);
+    EXPECT_EQ(map.cover_class_at({3, 3}), CoverClass::sparse);
+    EXPECT_EQ(map.cover_class_at({-1, 1}), CoverClass::normal);
+    // Well inside the bare square (further than a leaf reaches): no plant at all.
+    EXPECT_EQ(map.cover_fraction(rectangle(0.5, 0.5, 1.0, 1.0)), 0.0);
+    const double sparse = map.cover_fraction(rectangle(2.5, 2.5, 1.0, 1.0));
+    const double normal = map.cover_fraction(rectangle(-2.0, 0.5, 1.0, 1.0));
+    EXPECT_GT(sparse, 0.1);
+    EXPECT_GT(normal, sparse + 0.15);
+    // A patch changes only its own plants: outside every patch, the field is
+    // the one without patches.
+    const CropCoverMap plain(CropCoverParams{}, 5);
+    EXPECT_DOUBLE_EQ(map.cover_fraction(rectangle(-2.0, 0.5, 1.0, 1.0)), plain.cover_fraction(rectangle(-2.0, 0.5, 1.0, 1.0)));
+}
+
+TEST(CropCoverMap, CoverFractionIsTheShareOfPlantCellsInside) {
+    // A turned quadrilateral counted directly cell by cell at 1 mm.
+    const CropCoverMap map(CropCoverParams{}, 11);
+    const Vec2 origin{3.0, -1.0};
+    const Vec2 across = right_of(30.0);
+    const Vec2 ahead = forward_of(30.0);
+    const std::array<Vec2, 4> quad{origin, origin + 0.6 * across, origin + 0.6 * across + 0.4 * ahead, origin + 0.4 * ahead};
+    long inside = 0;
+    long plant = 0;
+    // Corners (3, -1), (3.52, -1.3), (3.72, -0.954), (3.2, -0.654).
+    for (double e = 2.95; e < 3.8; e += 0.001) {
+        for (double n = -1.35; n < -0.6; n += 0.001) {
+            const Vec2 cell{(std::floor(e / 0.001) + 0.5) * 0.001, (std::floor(n / 0.001) + 0.5) * 0.001};
+            const Vec2 rel = cell - origin;
+            const double a = dot(rel, across);
+            const double b = dot(rel, ahead);
+            if (a < 0.0 || a > 0.6 || b < 0.0 || b > 0.4) continue;
+            ++inside;
+            if (map.is_plant(cell)) ++plant;
+        }
+    }
+    ASSERT_NEAR(static_cast<double>(inside), 240000.0, 1000.0);  // 0.24 m^2 at 1 mm
+    EXPECT_NEAR(map.cover_fraction(quad), static_cast<double>(plant) / static_cast<double>(inside), 0.002);
+}
+
+TEST(NozzleRoiGround, Sec21RectangleAheadOfTheNozzle) {
+    // Heading east (90 deg): ahead is +east, right is -north. Nozzle 0.25 m
+    // right of a boom centre at (10, 20): its ROI runs 0.2-0.6 m east of it,
+    // 0.3 m either side across.
+    const std::array<Vec2, 4> roi = nozzle_roi_ground({10.0, 20.0}, 90.0, 0.25);
+    EXPECT_NEAR(roi[0].east_m, 10.2, 1e-12);
+    EXPECT_NEAR(roi[0].north_m, 20.0 - 0.25 + 0.3, 1e-12);  // near-left
+    EXPECT_NEAR(roi[1].north_m, 20.0 - 0.25 - 0.3, 1e-12);  // near-right
+    EXPECT_NEAR(roi[2].east_m, 10.6, 1e-12);                // far
+    EXPECT_NEAR(roi[3].north_m, roi[0].north_m, 1e-12);
+}
+
+TEST(CropCoverMap, BadInputIsNamed) {
+    CropCoverParams params;
+    params.row_spacing_m = 0.0;
+    try {
+        CropCoverMap map(params, 1);
+        ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find("crop.row_spacing_m"), std::string::npos) << error.what();
+    }
+    params = CropCoverParams{};
+    params.plant_height_max_m = 0.01;  // below the minimum
+    EXPECT_THROW(CropCoverMap(params, 1), std::invalid_argument);
+    const CropCoverMap map(CropCoverParams{}, 1);
+    EXPECT_THROW(map.cover_fraction({Vec2{0, 0}, Vec2{1, 1}, Vec2{1, 0}, Vec2{0, 1}}), std::invalid_argument);  // bow-tie
+    EXPECT_THROW(map.cover_fraction({Vec2{0, 0}, Vec2{NAN, 0}, Vec2{1, 1}, Vec2{0, 1}}), std::invalid_argument);
+    EXPECT_THROW(map.cover_fraction(rectangle(0.0, 0.0, 0.0001, 0.0001)), std::invalid_argument);  // no cell centre inside
+    EXPECT_THROW((void)map.is_plant(Vec2{NAN, 0.0}), std::invalid_argument);
+    EXPECT_THROW((void)map.is_plant(Vec2{0.0, 2e6}), std::invalid_argument);
+}
+
+}  // namespace
