@@ -165,7 +165,10 @@ struct GnssWireFaultsSpec {
 struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
     double rate_hz = 5.0;      // [1, 20]; the G970II runs at 5 Hz
-    double latency_s = 0.02;   // [0, 1): fix epoch -> the epoch's last sentence complete at the controller
+    // [0, 1): fix epoch -> the epoch's last sentence complete at the controller.
+    // A fit, with EncoderSpec::deflection_pct, to Table 3 (README "Every fitted
+    // parameter"): a receiver's own output delay plus about 150 bytes of GGA+RMC.
+    double latency_s = 0.10;
     // Receiver epochs fall at epoch_phase_s + k / rate_hz of simulated time. The
     // receiver's epoch grid has nothing to do with where the sprayer is, so when
     // the file does not fix it, it is drawn from the seed in [0, 1 / rate_hz):
@@ -184,7 +187,10 @@ struct EncoderSpec {
     double rate_hz = 100.0;               // count publication rate, [1, 1000]
     double slip_pct = 0.0;                // mean wheel slip, [-20, 20]; ideal wheel unless the case says so
     double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), [0, 10]
-    double deflection_pct = 0.0;          // loaded tyre: rolling radius below nominal, [0, 20) (emulators/land_wheel.h)
+    // Loaded tyre: rolling radius below nominal, [0, 20) (emulators/land_wheel.h).
+    // A fit, with GnssSpec::latency_s, to Table 3's fusion errors; the plant's
+    // own default is an ideal wheel, which a case gets with deflection_pct: 0.
+    double deflection_pct = 3.0;
     double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
 };
 

@@ -227,7 +227,8 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     EXPECT_DOUBLE_EQ(spec.breakpoint.button_at_s, 1.0);
     EXPECT_EQ(spec.gnss.talker, GnssTalker::gp);
     EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 5.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.02);
+    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.10);  // the Table 3 fit
+    EXPECT_DOUBLE_EQ(spec.encoder.deflection_pct, 3.0);
     EXPECT_EQ(spec.gnss.fix, GnssFix::rtk_fixed);
     EXPECT_DOUBLE_EQ(spec.gnss.noise.base_m, 0.008);
     EXPECT_DOUBLE_EQ(spec.gnss.noise.ppm, 1.0);
