@@ -7,6 +7,13 @@ function(rig_target_defaults target)
   if(RIG_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
+  if(RIG_LINE_TABLES_ONLY)
+    # -g1 (after the build type's -g, so it wins): file and line for every
+    # instruction, which is what a backtrace, a sanitizer report or perf needs,
+    # without the types and locals a debugger reads. Measured on this tree
+    # (GCC 12): judge.cpp 15.1 s at -O2 -g, 10.4 s at -O2 -g1.
+    target_compile_options(${target} PRIVATE -g1)
+  endif()
   if(RIG_SANITIZE)
     # -O1 -g1 (after the build type's flags, so they win): what ASan's own
     # documentation suggests for usable speed and stack traces with line
@@ -49,6 +56,12 @@ function(rig_add_test name)
   cmake_parse_arguments(T "" "" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${T_SOURCES})
   rig_target_defaults(${name})
+  # The test bodies at -O1 whatever the build type: they are GoogleTest macro
+  # expansions whose optimisation at -O2 costs most of a test's compile time
+  # (case_spec_test.cpp: 14.8 s at -O2 -g, 7.4 s at -O1 -g1, of which 2.4 s is
+  # parsing) and buys nothing; the code under test is in the libraries, built
+  # at the build type's level (-O2 in RelWithDebInfo).
+  target_compile_options(${name} PRIVATE -O1)
   target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE
     RIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"

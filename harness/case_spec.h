@@ -21,8 +21,8 @@
 #include <string_view>
 #include <vector>
 
+#include "emulators/spray_circuit_params.h"
 #include "harness/board_spec.h"
-#include "emulators/spray_circuit.h"
 #include "harness/realtime_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
@@ -200,7 +200,7 @@ struct ThrottleStepSpec {
     double flow_l_min = 0.0;                 // required, (0, 200], as pump_flow_l_min
 };
 
-// The spray circuit (emulators/spray_circuit.h, ball_valve.h, flow_map.h). Each
+// The spray circuit (emulators/spray_circuit.h, spray_circuit_params.h). Each
 // default is the plant's own (emulators::SprayCircuitParams and the structs it
 // holds), where the value is declared once with its unit and provenance (paper,
 // fit or assumed); this struct only names the keys. Ranges are in
