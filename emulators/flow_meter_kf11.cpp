@@ -7,7 +7,7 @@
 
 namespace rig::emulators {
 
-FlowMeterKf11::FlowMeterKf11(SprayCircuit& circuit, Kf11Params params)
+FlowMeterKf11::FlowMeterKf11(const SprayCircuit& circuit, Kf11Params params)
     : circuit_(circuit), params_(params), period_ns_(seconds_to_ns(1.0 / params.rate_hz)) {
     if (!(params.pulses_per_l > 0.0) || !(params.rate_hz > 0.0)) {
         throw std::invalid_argument("KF11 flow meter: pulses_per_l and rate_hz must be > 0");
@@ -19,7 +19,7 @@ void FlowMeterKf11::configure(DdsContext& dds) {
 }
 
 TimeNs FlowMeterKf11::step(TimeNs now_ns) {
-    circuit_.advance_to(now_ns);
+    circuit_.require_advanced_to(now_ns, name_);
     const double volume_l = circuit_.main_volume_l();
     const double interval_s = ns_to_seconds(now_ns - last_sample_ns_);
     const double passed_l = volume_l - last_volume_l_;

@@ -32,7 +32,7 @@ struct Kf11Params {
 
 class FlowMeterKf11 final : public Node {
 public:
-    FlowMeterKf11(SprayCircuit& circuit, Kf11Params params);
+    FlowMeterKf11(const SprayCircuit& circuit, Kf11Params params);
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
@@ -46,7 +46,7 @@ public:
 
 private:
     std::string name_ = "main_flow_meter";
-    SprayCircuit& circuit_;
+    const SprayCircuit& circuit_;
     Kf11Params params_;
     TimeNs period_ns_;
     TimeNs last_sample_ns_ = 0;

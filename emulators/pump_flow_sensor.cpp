@@ -8,7 +8,7 @@
 
 namespace rig::emulators {
 
-PumpFlowSensor::PumpFlowSensor(SprayCircuit& circuit, PumpFlowSensorParams params)
+PumpFlowSensor::PumpFlowSensor(const SprayCircuit& circuit, PumpFlowSensorParams params)
     : circuit_(circuit), params_(params), noise_(params.seed, "pump_flow_sensor"),
       period_ns_(seconds_to_ns(1.0 / params.rate_hz)) {
     if (!(params.full_scale_m3_h > 0.0) || !(params.rate_hz > 0.0) || !(params.noise_mv >= 0.0)) {
@@ -27,7 +27,7 @@ double PumpFlowSensor::voltage_for(double pump_flow_l_min) const {
 }
 
 TimeNs PumpFlowSensor::step(TimeNs now_ns) {
-    circuit_.advance_to(now_ns);
+    circuit_.require_advanced_to(now_ns, name_);
     const double noisy_v = voltage_for(circuit_.pump_flow_l_min()) + noise_.gaussian() * params_.noise_mv / 1000.0;
     msg::AnalogInput sample;
     sample.voltage_v(std::clamp(noisy_v, 0.0, io::kAdcReferenceV));

@@ -29,7 +29,7 @@ struct PumpFlowSensorParams {
 
 class PumpFlowSensor final : public Node {
 public:
-    PumpFlowSensor(SprayCircuit& circuit, PumpFlowSensorParams params);
+    PumpFlowSensor(const SprayCircuit& circuit, PumpFlowSensorParams params);
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
@@ -38,7 +38,7 @@ public:
 
 private:
     std::string name_ = "pump_flow_sensor";
-    SprayCircuit& circuit_;
+    const SprayCircuit& circuit_;
     PumpFlowSensorParams params_;
     SeededRandom noise_;
     TimeNs period_ns_;

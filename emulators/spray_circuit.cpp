@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -89,8 +90,22 @@ double SprayCircuit::throttle_flow_l_min(double t_s) const {
 }
 
 void SprayCircuit::advance_to(TimeNs t) {
+    advanced_to_ns_ = std::max(advanced_to_ns_, t);
     const std::int64_t target_steps = t / step_ns_;
     while (steps_done_ < target_steps) step_once();
+}
+
+void SprayCircuit::require_advanced_to(TimeNs now_ns, const std::string& device) const {
+    if (now_ns == advanced_to_ns_) return;
+    const auto seconds = [](TimeNs t) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6f s", ns_to_seconds(t));
+        return std::string(text);
+    };
+    throw std::logic_error(device + " sampled the spray circuit at t=" + seconds(now_ns) +
+                           " but the circuit was advanced to t=" + seconds(advanced_to_ns_) +
+                           ": the master advances it to each instant before the devices step "
+                           "(add_truth_model), a device never does");
 }
 
 void SprayCircuit::set_valve_drive(BallValve::Drive drive) { valve_.set_drive(drive); }

@@ -41,6 +41,7 @@
 //               booked in the deposition grid under the vehicle's current pass.
 #include <cstdint>
 #include <deque>
+#include <string>
 #include <vector>
 
 #include "emulators/ball_valve.h"
@@ -49,6 +50,7 @@
 #include "emulators/plant.h"
 #include "emulators/spray_circuit_params.h"
 #include "rig/runtime/clock.h"
+#include "rig/runtime/node.h"
 
 namespace rig::emulators {
 
@@ -58,13 +60,23 @@ struct LandingEdge {
     bool landing = false;   // true: the first droplets touch the ground; false: the last did
 };
 
-class SprayCircuit {
+// Advanced by the master (rig/runtime/node.h TruthModel), once per instant;
+// the device nodes (flow meters, the actuator node) only read it at the instant
+// it was advanced to, and say so if it was not (require_advanced_to).
+class SprayCircuit final : public TruthModel {
 public:
     // Throws std::invalid_argument naming the bad parameter.
     SprayCircuit(const Plant& plant, SprayCircuitParams params);
 
-    // Integrates up to t (whole steps); t must not go backwards.
-    void advance_to(TimeNs t);
+    // Integrates up to t (whole steps); an earlier t than the last changes nothing.
+    void advance_to(TimeNs t) override;
+    // The last instant advance_to() was given (0 before the first).
+    TimeNs advanced_to_ns() const { return advanced_to_ns_; }
+    // For a device node sampling the circuit at now_ns: throws std::logic_error,
+    // naming `device`, unless the circuit was advanced to exactly that instant
+    // (a node stepped by something that does not advance the plant would read
+    // the past).
+    void require_advanced_to(TimeNs now_ns, const std::string& device) const;
 
     // Actuators, effective from the current instant (call advance_to first).
     void set_valve_drive(BallValve::Drive drive);
@@ -98,6 +110,7 @@ private:
     double throttle_flow_l_min(double t_s) const;
 
     const Plant& plant_;
+    TimeNs advanced_to_ns_ = 0;
     SprayCircuitParams params_;
     BallValve valve_;
     FlowMap flow_map_;

@@ -19,8 +19,10 @@ bool SprayCircuitNode::has_unread_input() const {
 }
 
 TimeNs SprayCircuitNode::step(TimeNs now_ns) {
-    // Everything up to now happened under the previous commands.
-    circuit_.advance_to(now_ns);
+    // Everything up to now happened under the previous commands: the master
+    // advanced the circuit to now before any node stepped; the commands taken
+    // here act from now on.
+    circuit_.require_advanced_to(now_ns, name_);
     for (const auto& relays : relays_reader_->take_all()) {
         using Drive = BallValve::Drive;
         circuit_.set_valve_drive(relays.forward() && relays.reverse() ? Drive::both

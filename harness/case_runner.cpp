@@ -53,11 +53,13 @@ constexpr std::chrono::milliseconds kWireUnreadBound{2000};
 // The device emulators and the plant as the case's local nodes, in the order
 // they step each instant: plant truth and the spray circuit (which takes the
 // actuator commands) before the devices sample them, the wire adapters last
-// (they carry what the devices published).
+// (they carry what the devices published). The circuit itself is the master's
+// to advance (`truth`), once per instant before any of them steps.
 struct LocalNodes {
     LocalNodes(const CaseSpec& spec, const CaseWorld& world, emulators::SprayCircuit& circuit, std::uint64_t seed,
                BenchWires& wires)
-        : plant(world.plant, kVehicleTruthRateHz),
+        : truth(circuit),
+          plant(world.plant, kVehicleTruthRateHz),
           spray_circuit(circuit, kHydraulicsTruthRateHz),
           gnss(world.plant, world.gnss),
           encoder(world.plant, emulators::WheelEncoderParams{spec.encoder.pulses_per_rev,
@@ -74,6 +76,7 @@ struct LocalNodes {
         if (wires.gnss_port) all.push_back(&nmea_adapter.emplace(*wires.gnss_port));
         if (wires.board_io) all.push_back(&board_adapter.emplace(*wires.board_io, spec.wiring.board_update_hz));
     }
+    TruthModel& truth;
     emulators::PlantNode plant;
     emulators::SprayCircuitNode spray_circuit;
     emulators::GnssG970 gnss;
@@ -241,6 +244,7 @@ void run_lockstep(const CaseSpec& spec, DdsContext& dds, LocalNodes& nodes, Case
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
     LockstepMaster master(dds, timeouts_of(spec));
+    master.add_truth_model(nodes.truth);
     for (Node* node : nodes.all) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });
     if (InProcessController* controller = session.in_process_controller()) {
@@ -286,12 +290,15 @@ std::string raise_wire_threads(BenchWires& wires, int priority) {
 }
 
 // Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
-void run_realtime(const CaseSpec& spec, DdsContext& dds, const std::vector<Node*>& nodes, CaseSession& session,
+// `truth`, if any, is advanced to each pass's instant before the nodes step.
+void run_realtime(const CaseSpec& spec, DdsContext& dds, const std::vector<Node*>& nodes, TruthModel* truth,
+                  CaseSession& session,
                   TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
                   const WallStopwatch& wall) {
     facts.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
     facts.realtime_scheduling += raise_wire_threads(session.wires(), kWireThreadPriority);
     RealtimeMaster master(dds, timeouts_of(spec));
+    if (truth != nullptr) master.add_truth_model(*truth);
     for (Node* node : nodes) master.add_local_node(*node);
     if (session.has_controller_process()) master.add_remote_node("controller", [&session] { return session.controller_gone(); });
     if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(session.wires().board_io.get())) {
@@ -405,7 +412,7 @@ void run_case_in_realtime(const CaseSpec& spec, DdsContext& dds, const std::vect
         run_facts = run_facts_json(facts, wall.elapsed_s());
     };
     try {
-        run_realtime(spec, dds, nodes, session, trace, watchdog, end_ns, now_ns, facts, wall);
+        run_realtime(spec, dds, nodes, nullptr, session, trace, watchdog, end_ns, now_ns, facts, wall);
     } catch (...) {
         record_facts();
         throw;
@@ -517,7 +524,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
                 if (spec.mode == RunMode::lockstep) {
                     run_lockstep(spec, dds, nodes, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
                 } else {
-                    run_realtime(spec, dds, nodes.all, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
+                    run_realtime(spec, dds, nodes.all, &nodes.truth, session, trace, watchdog, world.end_ns, now_ns, facts, wall);
                 }
                 circuit.advance_to(world.end_ns);
             },

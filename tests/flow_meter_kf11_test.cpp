@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "emulators/flow_meter_kf11.h"
@@ -55,11 +57,14 @@ struct MeterRig {
         std::uint32_t capture_us;
         double volume_l;
     };
-    // Steps the meter on its own schedule (100 Hz) up to `end_ns`, recording each sample.
+    // Steps the meter on its own schedule (100 Hz) up to `end_ns`, recording each
+    // sample; the test is the master here, advancing the plant before the meter
+    // samples it.
     std::vector<Sample> run_until(TimeNs end_ns) {
         std::vector<Sample> samples;
         while (next_ns <= end_ns) {
             const TimeNs now = next_ns;
+            circuit.advance_to(now);
             next_ns = meter.step(now);
             samples.push_back({now, meter.count(), meter.last_edge_capture_us(), circuit.main_volume_l()});
         }
@@ -164,6 +169,28 @@ TEST(FlowMeterKf11, LastEdgeCaptureLiesInTheLastSampleIntervalAndMatchesTheFlow)
     const auto& last = samples[changed.back()];
     const double t2_s = static_cast<double>(last.capture_us - first.capture_us) * 1e-6;
     EXPECT_NEAR(60.0 * static_cast<double>(last.count - first.count) / (90.0 * t2_s), 25.5, 0.005);
+}
+
+// The meter samples the plant; it never moves the plant's time. Stepped at an
+// instant the plant was not advanced to (by the master, rig/runtime/node.h
+// TruthModel; by run_until here) it would read the past, so it refuses, naming
+// itself and both instants, and counts nothing.
+TEST(FlowMeterKf11, RefusesToSampleAPlantNotAdvancedToItsInstant) {
+    MeterRig rig(95.0, Kf11Params{});
+    rig.run_until(1 * kS);
+    const std::uint32_t counted = rig.meter.count();
+    ASSERT_GT(counted, 0u);
+    try {
+        rig.meter.step(1 * kS + 10 * kMs);
+        FAIL() << "stepped at an instant the plant was not advanced to";
+    } catch (const std::logic_error& error) {
+        const std::string what = error.what();
+        EXPECT_NE(what.find("main_flow_meter"), std::string::npos) << what;
+        EXPECT_NE(what.find("t=1.010000 s"), std::string::npos) << what;
+        EXPECT_NE(what.find("t=1.000000 s"), std::string::npos) << what;
+    }
+    EXPECT_EQ(rig.meter.count(), counted);
+    EXPECT_EQ(rig.circuit.advanced_to_ns(), 1 * kS);
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "rig/host/child_process.h"
 #include "rig/runtime/dds_context.h"
@@ -64,6 +66,59 @@ std::map<rig::TimeNs, std::string> run_echo_case(rig::TimeNs end_ns) {
     master.shutdown();
     EXPECT_EQ(echo.process->stop(), "process exited with status 0");
     return seen;
+}
+
+// A plant whose time only the master moves: it logs every advance.
+class LoggingTruth final : public rig::TruthModel {
+public:
+    void advance_to(rig::TimeNs now_ns) override { log.push_back("advance " + std::to_string(now_ns)); }
+    std::vector<std::string> log;
+};
+
+// A sensor that samples the plant every `period`: it logs the instant it steps
+// at, into the same log, so the order of advance and sample is visible.
+class LoggingSensor final : public rig::Node {
+public:
+    LoggingSensor(std::string name, rig::TimeNs period, std::vector<std::string>& log)
+        : name_(std::move(name)), period_(period), log_(log) {}
+    const std::string& name() const override { return name_; }
+    void configure(rig::DdsContext&) override {}
+    rig::TimeNs step(rig::TimeNs now_ns) override {
+        log_.push_back(name_ + " " + std::to_string(now_ns));
+        return now_ns + period_;
+    }
+
+private:
+    std::string name_;
+    rig::TimeNs period_;
+    std::vector<std::string>& log_;
+};
+
+// The plant is advanced once per instant, before any local node steps at it,
+// whichever nodes are due; a device never advances it (rig/runtime/node.h).
+TEST(Lockstep, TheTruthModelIsAdvancedOncePerInstantBeforeTheNodesStep) {
+    rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext dds(lease.domain_id(), "harness");
+    LoggingTruth truth;
+    LoggingSensor fast("fast", 20'000'000, truth.log);
+    LoggingSensor slow("slow", 50'000'000, truth.log);
+    rig::LockstepMaster master(dds, rig::LockstepTimeouts{});
+    master.add_truth_model(truth);
+    master.add_local_node(fast);
+    master.add_local_node(slow);
+    master.start();
+    while (master.advance(100'000'000)) {
+    }
+    master.shutdown();
+    const std::vector<std::string> expected{
+        "advance 0",         "fast 0",         "slow 0",           //
+        "advance 20000000",  "fast 20000000",                      //
+        "advance 40000000",  "fast 40000000",                      //
+        "advance 50000000",  "slow 50000000",                      //
+        "advance 60000000",  "fast 60000000",                      //
+        "advance 80000000",  "fast 80000000",                      //
+        "advance 100000000", "fast 100000000", "slow 100000000"};
+    EXPECT_EQ(truth.log, expected);
 }
 
 TEST(Lockstep, SamplePublishedAtTIsSeenAtTAndRunsAreIdentical) {

@@ -402,6 +402,7 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
     if (t == kNever || t > until_ns) return std::nullopt;
     t = std::max(t, now_ns_);  // a node asking for the past is due now
     now_ns_ = t;
+    for (TruthModel* model : truth_models_) model->advance_to(t);
 
     std::uint32_t published_by_remotes = 0;
     for (int round = 0;; ++round) {

@@ -77,6 +77,8 @@ public:
 
     // Local nodes run in the master's process and are stepped in the order added.
     void add_local_node(Node& node);
+    // Advanced to each instant before the local nodes step at it (rig/runtime/node.h).
+    void add_truth_model(TruthModel& model) { truth_models_.push_back(&model); }
     // A remote node (its own process). `liveness` returns an error text when the
     // node is known to be gone (e.g. its process exited), checked while waiting.
     void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
@@ -169,6 +171,7 @@ private:
     DdsContext& dds_;
     LockstepTimeouts timeouts_;
     std::vector<Local> locals_;
+    std::vector<TruthModel*> truth_models_;
     std::vector<Remote> remotes_;
     std::unique_ptr<Writer<msg::ClockTick>> tick_writer_;
     std::unique_ptr<Reader<msg::ClockAck>> ack_reader_;

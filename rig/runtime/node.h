@@ -29,4 +29,17 @@ public:
     virtual void shutdown() {}
 };
 
+// The plant's state that evolves under the actuators (the spray circuit), which
+// the device nodes sample. The master advances it to each instant once, before
+// any local node steps at that instant; nodes only read it. So what a sensor
+// reports at t is the plant at t whichever node ran first, and no device can
+// move the plant's time (ros2_control's split: the framework moves the state,
+// components read and write it).
+class TruthModel {
+public:
+    virtual ~TruthModel() = default;
+    // Integrate up to `now_ns`; called with non-decreasing instants.
+    virtual void advance_to(TimeNs now_ns) = 0;
+};
+
 }  // namespace rig

@@ -95,6 +95,7 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
         }
         const TimeNs now = clock_.now_ns();
         if (now >= end_ns) return;
+        for (TruthModel* model : truth_models_) model->advance_to(now);
         for (Local& local : locals_) {
             if (local.next_wake_ns <= now) {
                 // Late by when its step began: a long step of a node before it in

@@ -69,6 +69,8 @@ public:
     ~RealtimeMaster();
 
     void add_local_node(Node& node);
+    // Advanced to each pass's instant before the local nodes step (rig/runtime/node.h).
+    void add_truth_model(TruthModel& model) { truth_models_.push_back(&model); }
     void add_remote_node(const std::string& name, std::function<std::optional<std::string>()> liveness);
     // Called after every pass through the loop with the instant it began (the
     // trace recorder drains its readers here).
@@ -119,6 +121,7 @@ private:
     LockstepMaster remotes_;
     RealtimeClock clock_;
     std::vector<Local> locals_;
+    std::vector<TruthModel*> truth_models_;
     LatenessAccount lateness_;
     TimeNs stall_at_ns_ = kNever;
     TimeNs stall_for_ns_ = 0;
