@@ -60,12 +60,13 @@ CaseRun run_without_trace(const CaseSpec& spec, std::uint64_t seed, const std::s
     result.seed = seed;
     result.mode = std::string(to_string(spec.mode));
     result.limits = spec.limits;
-    result.expected_error = spec.expect.error;
+    const ExpectSpec expect = applied_expectation(spec, &result.expectation_set_aside);
+    result.expected_error = expect.error;
     result.error_kind = std::string(to_string(kind));
     result.error = error;
     result.wall_seconds = wall_seconds;
     const CaseVerdict verdict =
-        judge_case(VerdictInputs{{}, {}, result.limits, spec.expect.fail, spec.expect.error, result.error_kind, error});
+        judge_case(VerdictInputs{{}, {}, result.limits, expect.fail, expect.error, result.error_kind, error});
     result.failures = verdict.failures;
     result.expected_failure = verdict.expected_failure;
     result.passed = verdict.passed;
@@ -76,8 +77,9 @@ std::string judging_json(const CaseSpec& spec) {
     JudgingPlan plan;
     plan.scenario = "boundary";
     plan.limits = spec.limits;
-    plan.expect_fail = spec.expect.fail;
-    plan.expect_error = spec.expect.error;
+    const ExpectSpec expect = applied_expectation(spec, &plan.expect_set_aside);
+    plan.expect_fail = expect.fail;
+    plan.expect_error = expect.error;
     nlohmann::json json = to_json(plan);
     json["boundary"] = to_json(plan_boundary_judging(*spec.boundary));
     return json.dump();

@@ -386,12 +386,13 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
     result.seed = seed;
     result.mode = std::string(to_string(spec.mode));
     result.limits = effective_limits(spec);
-    result.expected_error = spec.expect.error;
+    const ExpectSpec expect = applied_expectation(spec, &result.expectation_set_aside);
+    result.expected_error = expect.error;
     result.error_kind = std::string(to_string(kind));
     result.error = error;
     result.wall_seconds = wall_seconds;
     const CaseVerdict verdict =
-        judge_case(VerdictInputs{{}, {}, result.limits, spec.expect.fail, spec.expect.error, result.error_kind, error});
+        judge_case(VerdictInputs{{}, {}, result.limits, expect.fail, expect.error, result.error_kind, error});
     result.failures = verdict.failures;
     result.expected_failure = verdict.expected_failure;
     result.passed = verdict.passed;

@@ -561,6 +561,15 @@ ExpectSpec read_expect(const YamlSection& section) {
                                   "an errored case is not judged on its metrics");
         }
     }
+    if (section.has("controller")) {
+        const std::string whose = section.required<std::string>("controller");
+        if (whose != "reference" && whose != "any") {
+            section.fail("controller", "'" + whose +
+                                           "' is not whose behaviour an expectation can describe: reference (the "
+                                           "rig's reference controller, the default) or any");
+        }
+        expect.any_controller = whose == "any";
+    }
     return expect;
 }
 
@@ -996,6 +1005,29 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
         paths.insert(paths.end(), cases.begin(), cases.end());
     }
     return paths;
+}
+
+ExpectSpec applied_expectation(const CaseSpec& spec, std::string* set_aside) {
+    const bool reference = spec.controller.command.empty() && spec.controller.plugin.empty();
+    const bool has_expectation = !spec.expect.fail.empty() || !spec.expect.error.empty();
+    if (reference || spec.expect.any_controller || !has_expectation) return spec.expect;
+    if (set_aside != nullptr) {
+        const std::string controller = !spec.controller.command.empty() ? spec.controller.command.front()
+                                                                         : spec.controller.plugin.string();
+        const std::string expected = !spec.expect.error.empty() ? "an error, " + spec.expect.error
+                                                                : "failures of " + [&] {
+                                                                      std::string names;
+                                                                      for (const std::string& name : spec.expect.fail) {
+                                                                          names += (names.empty() ? "" : ", ") + name;
+                                                                      }
+                                                                      return names;
+                                                                  }();
+        *set_aside = "the case expects " + expected + " of the reference controller; it ran " + controller +
+                     ", which is judged on the limits alone (expect.controller: any keeps the expectation)";
+    }
+    ExpectSpec none;
+    none.any_controller = spec.expect.any_controller;
+    return none;
 }
 
 }  // namespace rig::harness

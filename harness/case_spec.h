@@ -333,6 +333,14 @@ struct ExpectSpec {
     // node_exited, node_unresponsive, topic_role_violation); the case passes
     // only when it does. Exclusive with `fail`.
     std::string error;
+    // Whose behaviour the expectation describes: `reference` (the default), the
+    // rig's reference controller, so it is set aside when the case runs another
+    // controller (`controller.command` or `.plugin`): a team that puts its own
+    // controller into a paper case the reference controller fails (Table 2's
+    // 16 L/min) is judged on the limits, not against the reference's failure;
+    // `any`, whatever runs (a negative case written for the team's own
+    // controller or stand-in).
+    bool any_controller = false;
 };
 
 struct TimeoutsSpec {
@@ -425,6 +433,11 @@ inline constexpr std::array<std::string_view, 24> kMetricUnitSuffixes = {
 };
 // Empty when `name` is a valid metric name, else why not.
 std::string metric_name_problem(std::string_view name);
+
+// The expectation the case is judged with: spec.expect, or none when it
+// describes the reference controller and the case runs another; then
+// `set_aside` (if given) says so, naming the controller.
+ExpectSpec applied_expectation(const CaseSpec& spec, std::string* set_aside = nullptr);
 
 // The case's limits over `defaults` (the file wins).
 std::map<std::string, double> effective_limits(const CaseSpec& spec,

@@ -180,8 +180,9 @@ JudgingPlan plan_judging(const CaseSpec& spec, const CaseWorld& world) {
     plan.field_origin_height_m = spec.field.origin.height_m;
     plan.field_heading_deg = spec.field.heading_deg;
     plan.limits = effective_limits(spec);
-    plan.expect_fail = spec.expect.fail;
-    plan.expect_error = spec.expect.error;
+    const ExpectSpec expect = applied_expectation(spec, &plan.expect_set_aside);
+    plan.expect_fail = expect.fail;
+    plan.expect_error = expect.error;
     plan.judge_breakpoint = !stands_still(spec.scenario);
     plan.judge_flow = spec.scenario != Scenario::breakpoint_identification && spec.scenario != Scenario::valve_calibration;
     plan.judge_fig11 = spec.scenario == Scenario::valve_calibration;

@@ -33,7 +33,7 @@ nlohmann::json to_json(const JudgingPlan& plan) {
         {"judge_flow", plan.judge_flow},
         {"judge_deposition", plan.judge_deposition},
         {"limits", plan.limits},
-        {"expect", {{"fail", plan.expect_fail}, {"error", plan.expect_error}}},
+        {"expect", {{"fail", plan.expect_fail}, {"error", plan.expect_error}, {"set_aside", plan.expect_set_aside}}},
     };
     if (plan.judge_flow) {
         json["flow"] = {{"target_l_min", plan.flow.target_l_min},
@@ -81,6 +81,8 @@ JudgingPlan judging_plan_from_json(const nlohmann::json& json) {
         const nlohmann::json& expect = at(json, "expect", "");
         plan.expect_fail = at(expect, "fail", "expect.").get<std::vector<std::string>>();
         plan.expect_error = at(expect, "error", "expect.").get<std::string>();
+        // Traces from before expectations could be set aside have no reason.
+        if (expect.contains("set_aside")) plan.expect_set_aside = at(expect, "set_aside", "expect.").get<std::string>();
         if (plan.judge_flow) {
             const nlohmann::json& flow = at(json, "flow", "");
             plan.flow.target_l_min = at(flow, "target_l_min", "flow.").get<double>();
@@ -532,6 +534,7 @@ CaseRun judge_trace(const RecordedTrace& trace) {
         const JudgingPlan plan = judging_plan_from_json(judging);
         result.limits = plan.limits;
         result.expected_error = plan.expect_error;
+        result.expectation_set_aside = plan.expect_set_aside;
         figures.breakpoint_along_m = plan.breakpoint_along_m;
         // The trace says who touched what, whatever the run noticed live.
         if (result.error.empty()) {

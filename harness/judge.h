@@ -45,6 +45,9 @@ struct JudgingPlan {
     std::map<std::string, double> limits;
     std::vector<std::string> expect_fail;
     std::string expect_error;
+    // Non-empty: the case's expectation was set aside, and why (applied_expectation,
+    // harness/case_spec.h); the run is judged on its limits alone.
+    std::string expect_set_aside;
 };
 nlohmann::json to_json(const JudgingPlan& plan);
 // Throws std::runtime_error naming the missing or malformed key.

@@ -428,6 +428,8 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"verdict", case_passed(result) ? "passed" : case_invalid(result) ? "invalid" : "failed"},
             {"expected_failure", result.expected_failure},
             {"expected_error", result.expected_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(result.expected_error)},
+            {"expectation_set_aside", result.expectation_set_aside.empty() ? nlohmann::json(nullptr)
+                                                                           : nlohmann::json(valid_utf8(result.expectation_set_aside))},
             {"seed", result.seed},
             {"metrics", std::move(metrics)},
             {"not_measured", std::move(not_measured)},
@@ -566,6 +568,7 @@ std::string junit_xml(const std::vector<CaseResult>& results, const RunSummary& 
             output += "XFAIL-OK: an expected failure: the case's expect: asked for exactly this outcome\n" +
                       join_lines(result.failures);
         }
+        if (!result.expectation_set_aside.empty()) output += "expectation set aside: " + result.expectation_set_aside + "\n";
         output += "seed: " + std::to_string(result.seed) + "\n";
         if (!result.trace_sha256.empty()) output += "trace: " + result.trace_path + " sha256 " + result.trace_sha256 + "\n";
         output += metrics_text(result);
@@ -640,6 +643,7 @@ std::string result_details(const std::vector<CaseResult>& results) {
             report += "trace: " + result.trace_path + "   sha256: " + result.trace_sha256 + "\n";
         }
         if (!result.error.empty()) report += "error (" + result.error_kind + "): " + result.error + "\n";
+        if (!result.expectation_set_aside.empty()) report += "expectation set aside: " + result.expectation_set_aside + "\n";
         for (const auto& [name, why] : result.not_measured) report += "not measured: " + name + ": " + why + "\n";
         if (!result.metrics.empty()) {
             report += "metrics:\n";

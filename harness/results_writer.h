@@ -37,6 +37,9 @@ struct CaseResult {
     std::string error;  // non-empty: the case did not run to the end (node died, bad config...)
     std::string error_kind;      // rig::FailureKind name of the error ("node_exited", ...)
     std::string expected_error;  // the case's expect.error: this error is the verdict it wants
+    // The case's expectation described the reference controller and another ran:
+    // why it was set aside (judged on the limits alone); empty otherwise.
+    std::string expectation_set_aside;
     std::string trace_sha256;
     std::string trace_path;
     double sim_seconds = 0.0;

@@ -314,6 +314,44 @@ TEST(CaseSpec, SeedsExpectedErrorsAndTheStripAllowances) {
     }
 }
 
+// An expectation describes the reference controller unless it says `any`: a
+// case run with another controller (command or plugin) is judged on its limits,
+// and the reason names the controller and what was expected.
+TEST(CaseSpec, AnExpectationOfTheReferenceControllerIsSetAsideForAnother) {
+    const std::string expecting = std::string(kMinimalCase) + "expect: { fail: [ breakpoint_error_m ] }\n";
+    const CaseSpec reference = parse_case(expecting, "reference.yaml");
+    std::string why;
+    EXPECT_EQ(applied_expectation(reference, &why).fail, (std::vector<std::string>{"breakpoint_error_m"}));
+    EXPECT_EQ(why, "");
+
+    const CaseSpec mine = parse_case(expecting + "controller: { command: [ ./mine, --fast ] }\n", "mine.yaml");
+    const ExpectSpec applied = applied_expectation(mine, &why);
+    EXPECT_TRUE(applied.fail.empty());
+    EXPECT_TRUE(applied.error.empty());
+    EXPECT_NE(why.find("failures of breakpoint_error_m of the reference controller"), std::string::npos) << why;
+    EXPECT_NE(why.find("it ran ./mine"), std::string::npos) << why;
+    EXPECT_EQ(mine.expect.fail, reference.expect.fail) << "the case as written is unchanged";
+
+    const CaseSpec plugin = parse_case(std::string(kMinimalCase) +
+                                           "expect: { error: node_exited }\ncontroller: { plugin: ./libmine.so }\n",
+                                       "plugin.yaml");
+    EXPECT_TRUE(applied_expectation(plugin, &why).error.empty());
+    EXPECT_NE(why.find("an error, node_exited"), std::string::npos) << why;
+
+    const CaseSpec any = parse_case(std::string(kMinimalCase) +
+                                        "expect: { error: node_exited, controller: any }\n"
+                                        "controller: { command: [ ./crashes ] }\n",
+                                    "any.yaml");
+    why.clear();
+    EXPECT_EQ(applied_expectation(any, &why).error, "node_exited");
+    EXPECT_EQ(why, "");
+
+    const CaseSpec explicit_reference = parse_case(expecting.substr(0, expecting.size() - 3) +
+                                                       ", controller: reference }\ncontroller: { command: [ ./mine ] }\n",
+                                                   "explicit.yaml");
+    EXPECT_TRUE(applied_expectation(explicit_reference).fail.empty());
+}
+
 TEST(CaseSpec, HarnessCanExtendTheDefaultLimits) {
     std::map<std::string, double> defaults = kDefaultLimits;
     defaults["spray_drift_m"] = 0.5;
@@ -446,6 +484,9 @@ const std::vector<BrokenFile>& broken_files() {
          "a seed is a whole number"},
         {"an expected error that is no kind of failure", std::string(kMinimalCase) + "expect: { error: crashed }\n",
          "8:18: expect.error:", "'crashed' is not a kind of run failure; one of: node_exited"},
+        {"an expectation of nobody in particular", std::string(kMinimalCase) +
+             "expect: { fail: [ breakpoint_error_m ], controller: mine }\n",
+         "8:53: expect.controller:", "'mine' is not whose behaviour an expectation can describe"},
         {"an expected error and expected metric breaks", std::string(kMinimalCase) +
              "expect: { fail: [ breakpoint_error_m ], error: node_exited }\n",
          "8:48: expect.error:", "cannot also expect metrics to break"},

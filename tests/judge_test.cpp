@@ -220,6 +220,30 @@ TEST(Judge, ATruthReaderFailsTheCaseNamingTopicAndParticipant) {
     EXPECT_TRUE(expected.expected_failure);
 }
 
+// A plan whose expectation was set aside (the case ran a controller other than
+// the reference, harness/case_spec.h applied_expectation): the same trace that
+// passes as an expected error is judged on its own, a failure, and the result
+// says why the expectation did not apply, from the trace alone.
+TEST(Judge, AnExpectationSetAsideIsNotAppliedAndTheResultSaysWhy) {
+    JudgingPlan plan = continuation_plan();
+    plan.expect_set_aside = "the case expects an error, topic_role_violation, of the reference controller; it ran ./mine";
+    const JudgingPlan back = judging_plan_from_json(to_json(plan));
+    EXPECT_EQ(back.expect_set_aside, plan.expect_set_aside);
+    HandMadeTrace made("truth-reader-set-aside", plan);
+    made.trace().record_discoveries(
+        0, {rig::DiscoveredEndpoint{"controller", "010f0a0b0c0d0e0f00000000", "truth/vehicle", "VehicleTruth", false, false}});
+    made.finish();
+    const CaseResult result = made.judged().result;
+    EXPECT_FALSE(case_passed(result));
+    EXPECT_FALSE(result.expected_failure);
+    EXPECT_EQ(result.error_kind, "topic_role_violation");
+    EXPECT_EQ(result.expectation_set_aside, plan.expect_set_aside);
+    // A trace from before the reason existed still reads (no set_aside key).
+    nlohmann::json old = to_json(continuation_plan());
+    old["expect"].erase("set_aside");
+    EXPECT_EQ(judging_plan_from_json(old).expect_set_aside, "");
+}
+
 TEST(Judge, ForgedTruthIsNeverJudgedAndFailsTheCase) {
     HandMadeTrace made("truth-forger", continuation_plan());
     made.drive();
