@@ -1008,12 +1008,14 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
 }
 
 ExpectSpec applied_expectation(const CaseSpec& spec, std::string* set_aside) {
-    const bool reference = spec.controller.command.empty() && spec.controller.plugin.empty();
+    const bool reference =
+        spec.controller.command.empty() && spec.controller.plugin.empty() && !spec.wiring.external_controller;
     const bool has_expectation = !spec.expect.fail.empty() || !spec.expect.error.empty();
     if (reference || spec.expect.any_controller || !has_expectation) return spec.expect;
     if (set_aside != nullptr) {
-        const std::string controller = !spec.controller.command.empty() ? spec.controller.command.front()
-                                                                         : spec.controller.plugin.string();
+        const std::string controller = spec.wiring.external_controller  ? std::string("an external board")
+                                       : !spec.controller.command.empty() ? spec.controller.command.front()
+                                                                          : spec.controller.plugin.string();
         const std::string expected = !spec.expect.error.empty() ? "an error, " + spec.expect.error
                                                                 : "failures of " + [&] {
                                                                       std::string names;

@@ -335,7 +335,7 @@ struct ExpectSpec {
     std::string error;
     // Whose behaviour the expectation describes: `reference` (the default), the
     // rig's reference controller, so it is set aside when the case runs another
-    // controller (`controller.command` or `.plugin`): a team that puts its own
+    // controller (`controller.command` or `.plugin`, or an external board): a team that puts its own
     // controller into a paper case the reference controller fails (Table 2's
     // 16 L/min) is judged on the limits, not against the reference's failure;
     // `any`, whatever runs (a negative case written for the team's own

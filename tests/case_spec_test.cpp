@@ -346,6 +346,11 @@ TEST(CaseSpec, AnExpectationOfTheReferenceControllerIsSetAsideForAnother) {
     EXPECT_EQ(applied_expectation(any, &why).error, "node_exited");
     EXPECT_EQ(why, "");
 
+    const CaseSpec board = parse_case(expecting + "mode: realtime\nwiring: { gnss: serial, gnss_port: pty, controller: external }\n",
+                                      "board.yaml");
+    EXPECT_TRUE(applied_expectation(board, &why).fail.empty());
+    EXPECT_NE(why.find("it ran an external board"), std::string::npos) << why;
+
     const CaseSpec explicit_reference = parse_case(expecting.substr(0, expecting.size() - 3) +
                                                        ", controller: reference }\ncontroller: { command: [ ./mine ] }\n",
                                                    "explicit.yaml");
