@@ -292,9 +292,8 @@ std::string raise_wire_threads(BenchWires& wires, int priority) {
 // Real time: the wall clock, for a board on real wires (rig/runtime/realtime.h).
 // `truth`, if any, is advanced to each pass's instant before the nodes step.
 void run_realtime(const CaseSpec& spec, DdsContext& dds, const std::vector<Node*>& nodes, TruthModel* truth,
-                  CaseSession& session,
-                  TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
-                  const WallStopwatch& wall) {
+                  CaseSession& session, TraceRecorder& trace, Watchdog& watchdog, TimeNs end_ns, TimeNs& now_ns,
+                  RunFacts& facts, const WallStopwatch& wall) {
     facts.realtime_scheduling = request_realtime_scheduling(kRealtimePriority).detail;
     facts.realtime_scheduling += raise_wire_threads(session.wires(), kWireThreadPriority);
     RealtimeMaster master(dds, timeouts_of(spec));

@@ -1008,28 +1008,23 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
 }
 
 ExpectSpec applied_expectation(const CaseSpec& spec, std::string* set_aside) {
+    const bool expects = !spec.expect.fail.empty() || !spec.expect.error.empty();
     const bool reference =
         spec.controller.command.empty() && spec.controller.plugin.empty() && !spec.wiring.external_controller;
-    const bool has_expectation = !spec.expect.fail.empty() || !spec.expect.error.empty();
-    if (reference || spec.expect.any_controller || !has_expectation) return spec.expect;
+    if (!expects || reference || spec.expect.any_controller) return spec.expect;
     if (set_aside != nullptr) {
-        const std::string controller = spec.wiring.external_controller  ? std::string("an external board")
+        // `fail` and `error` are exclusive (read_expect).
+        std::string expected = spec.expect.error.empty() ? "failures of " : "an error, " + spec.expect.error;
+        for (std::size_t index = 0; index < spec.expect.fail.size(); ++index) {
+            expected += (index == 0 ? "" : ", ") + spec.expect.fail[index];
+        }
+        const std::string controller = spec.wiring.external_controller    ? std::string("an external board")
                                        : !spec.controller.command.empty() ? spec.controller.command.front()
                                                                           : spec.controller.plugin.string();
-        const std::string expected = !spec.expect.error.empty() ? "an error, " + spec.expect.error
-                                                                : "failures of " + [&] {
-                                                                      std::string names;
-                                                                      for (const std::string& name : spec.expect.fail) {
-                                                                          names += (names.empty() ? "" : ", ") + name;
-                                                                      }
-                                                                      return names;
-                                                                  }();
         *set_aside = "the case expects " + expected + " of the reference controller; it ran " + controller +
                      ", which is judged on the limits alone (expect.controller: any keeps the expectation)";
     }
-    ExpectSpec none;
-    none.any_controller = spec.expect.any_controller;
-    return none;
+    return ExpectSpec{};
 }
 
 }  // namespace rig::harness
