@@ -83,7 +83,7 @@ TraceFile::TraceFile(const std::filesystem::path& file) : file_(file) {
     }
     exec(kSchema);
     if (sqlite3_prepare_v2(db_, "INSERT INTO samples VALUES (?, ?, ?, ?)", -1, &insert_, nullptr) != SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     digest_ = EVP_MD_CTX_new();
     EVP_DigestInit_ex(digest_, EVP_sha256(), nullptr);
@@ -97,7 +97,7 @@ TraceFile::~TraceFile() {
         try {
             sync();
         } catch (const std::exception& error) {
-            std::cerr << "rig: trace " << file_.string() << ": " << error.what() << "\n";
+            std::cerr << "rig: " << error.what() << "\n";  // it names the trace
         }
     }
     stop_writer();
@@ -105,7 +105,7 @@ TraceFile::~TraceFile() {
         try {
             finish(TraceOutcome{"interrupted", "interrupted", "the run ended before its trace was finished", last_t_ns_});
         } catch (const std::exception& error) {
-            std::cerr << "rig: trace " << file_.string() << ": " << error.what() << "\n";
+            std::cerr << "rig: " << error.what() << "\n";  // it names the trace
         }
     }
     if (insert_ != nullptr) sqlite3_finalize(insert_);
@@ -118,8 +118,16 @@ void TraceFile::exec(const char* sql) {
     if (sqlite3_exec(db_, sql, nullptr, nullptr, &error) != SQLITE_OK) {
         const std::string message = error != nullptr ? error : "unknown error";
         sqlite3_free(error);
-        throw std::runtime_error("trace " + file_.string() + ": " + message);
+        fail(message);
     }
+}
+
+void TraceFile::fail(const std::string& sqlite_error) {
+    {
+        std::lock_guard lock(queue_mutex_);
+        if (first_error_.empty()) first_error_ = sqlite_error;
+    }
+    throw std::runtime_error("trace " + file_.string() + ": " + sqlite_error);
 }
 
 void TraceFile::digest(const std::string& canonical) { EVP_DigestUpdate(digest_, canonical.data(), canonical.size()); }
@@ -168,13 +176,13 @@ void TraceFile::set_meta(const std::string& key, const std::string& value) {
     if (writer_.joinable()) sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT OR REPLACE INTO meta VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     sqlite3_bind_text(statement, 1, key.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(statement, 2, value.c_str(), -1, SQLITE_TRANSIENT);
     const int rc = sqlite3_step(statement);
     sqlite3_finalize(statement);
-    if (rc != SQLITE_DONE) throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+    if (rc != SQLITE_DONE) fail(sqlite3_errmsg(db_));
 }
 
 void TraceFile::append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json) {
@@ -203,7 +211,7 @@ void TraceFile::write_row(const PendingRow& row) {
     sqlite3_bind_text(insert_, 3, topic.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(insert_, 4, text.c_str(), -1, SQLITE_TRANSIENT);
     if (sqlite3_step(insert_) != SQLITE_DONE) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     sqlite3_reset(insert_);
     if (++rows_in_batch_ >= kRowsPerBatch) {
@@ -222,7 +230,7 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO foreign_samples VALUES (?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     sqlite3_bind_int64(statement, 1, t);
     sqlite3_bind_int(statement, 2, round);
@@ -232,7 +240,7 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
     sqlite3_bind_text(statement, 6, text.c_str(), -1, SQLITE_TRANSIENT);
     const int rc = sqlite3_step(statement);
     sqlite3_finalize(statement);
-    if (rc != SQLITE_DONE) throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+    if (rc != SQLITE_DONE) fail(sqlite3_errmsg(db_));
 }
 
 void TraceFile::record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoint>& endpoints) {
@@ -241,7 +249,7 @@ void TraceFile::record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoin
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO discovery VALUES (?, ?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     for (const DiscoveredEndpoint& endpoint : endpoints) {
         sqlite3_bind_int64(statement, 1, t);
@@ -254,7 +262,7 @@ void TraceFile::record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoin
         if (sqlite3_step(statement) != SQLITE_DONE) {
             const std::string error = sqlite3_errmsg(db_);
             sqlite3_finalize(statement);
-            throw std::runtime_error("trace " + file_.string() + ": " + error);
+            fail(error);
         }
         sqlite3_reset(statement);
     }
@@ -274,7 +282,7 @@ void TraceFile::record_deposition(const emulators::DepositionGrid& grid) {
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO deposition VALUES (?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     // Non-empty cells only; each one also goes into the digest, so a changed
     // deposition changes trace_sha256 like a changed sample does.
@@ -294,7 +302,7 @@ void TraceFile::record_deposition(const emulators::DepositionGrid& grid) {
                 if (sqlite3_step(statement) != SQLITE_DONE) {
                     const std::string error = sqlite3_errmsg(db_);
                     sqlite3_finalize(statement);
-                    throw std::runtime_error("trace " + file_.string() + ": " + error);
+                    fail(error);
                 }
                 sqlite3_reset(statement);
             }
@@ -307,7 +315,7 @@ void TraceFile::record_landing_edges(const std::vector<emulators::LandingEdge>& 
     sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO landing_edges VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
-        throw std::runtime_error("trace " + file_.string() + ": " + sqlite3_errmsg(db_));
+        fail(sqlite3_errmsg(db_));
     }
     for (const emulators::LandingEdge& edge : edges) {
         const std::string canonical =
@@ -318,7 +326,7 @@ void TraceFile::record_landing_edges(const std::vector<emulators::LandingEdge>& 
         if (sqlite3_step(statement) != SQLITE_DONE) {
             const std::string error = sqlite3_errmsg(db_);
             sqlite3_finalize(statement);
-            throw std::runtime_error("trace " + file_.string() + ": " + error);
+            fail(error);
         }
         sqlite3_reset(statement);
     }
@@ -334,8 +342,13 @@ std::string TraceFile::finish(const TraceOutcome& outcome) {
     // it alone, beside a digest of rows the file no longer has; the file keeps
     // outcome `running` instead, and the error that lost the rows is the one told.
     if (sqlite3_get_autocommit(db_) != 0) {
-        throw std::runtime_error("trace " + file_.string() +
-                                 ": a write failed earlier and its batch of rows was rolled back; not finished");
+        std::string cause;
+        {
+            std::lock_guard lock(queue_mutex_);
+            cause = first_error_.empty() ? "a write failed earlier" : "a write failed earlier (" + first_error_ + ")";
+        }
+        throw std::runtime_error("trace " + file_.string() + ": " + cause +
+                                 " and its batch of rows was rolled back; not finished");
     }
     if (digest_text_.empty()) {
         unsigned char hash[EVP_MAX_MD_SIZE];

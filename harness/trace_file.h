@@ -90,6 +90,8 @@ private:
         std::string topic;
         nlohmann::json json;
     };
+    // Records the first SQLite error (see first_error_), then throws it naming the file.
+    [[noreturn]] void fail(const std::string& sqlite_error);
     void exec(const char* sql);
     void digest(const std::string& canonical);
     void write_row(const PendingRow& row);  // on the writer thread
@@ -117,6 +119,10 @@ private:
     bool writing_ = false;             // the writer holds rows taken off the queue
     bool stopping_ = false;
     std::string writer_error_;
+    // The first SQLite error on either thread, kept for finish(): a write that
+    // failed on the caller's thread (a discovery row on a full disk) is caught
+    // by the run, and without it finish() could only say "a write failed".
+    std::string first_error_;
     std::thread writer_;
 };
 

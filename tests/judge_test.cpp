@@ -14,6 +14,11 @@
 #include "run_support.h"
 
 #include <sqlite3.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <cmath>
 #include <filesystem>
@@ -371,6 +376,60 @@ TEST(Judge, AnUnfinishedTraceIsReadableAsInterrupted) {
     const CaseResult result = judge_trace(trace).result;
     EXPECT_EQ(result.error_kind, "interrupted");
     EXPECT_NEAR(result.sim_seconds, 9.99, 1e-9);
+}
+
+// A write that fails on the run's own thread (a discovery row when the disk is
+// full) is caught by the run, which then finishes the trace. When SQLite rolled
+// the batch back, finish() refuses, and its error must still say what failed:
+// "a write failed earlier" alone sent a CI log reader looking for a rig bug.
+// In a child process, so that the file-size limit (RLIMIT_FSIZE: writes past it
+// fail with EFBIG, as on a full disk) binds only it.
+TEST(TraceFile, AWriteThatFailedOnTheRunsThreadIsNamedWhenFinishRefuses) {
+    const fs::path dir = rig::testing::fresh_dir("trace-write-failed");
+    const fs::path report = dir / "report.txt";
+    const pid_t child = ::fork();
+    ASSERT_NE(child, -1);
+    if (child == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails instead of killing the process
+        std::ofstream out(report);      // opened before the limit
+        const rlimit limit{256 * 1024, 256 * 1024};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        std::string first, second;
+        try {
+            TraceFile trace(dir / "trace.sqlite");
+            for (TimeNs t = 0; t < kS; t += 10 * kMs) trace.append(t, 0, "device/wheel_encoder/count", {{"count_pulses", t}});
+            rig::DiscoveredEndpoint huge{"controller", "01.0f", std::string(8 * 1024 * 1024, 't'), "T", true, false};
+            try {
+                trace.record_discoveries(kS, {huge});
+            } catch (const std::exception& error) {
+                first = error.what();
+            }
+            trace.finish(TraceOutcome{"error", "harness_error", first, kS});
+        } catch (const std::exception& error) {
+            second = error.what();
+        }
+        out << first << "\n" << second << "\n";
+        out.flush();
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
+    std::ifstream in(report);
+    std::string first, second;
+    std::getline(in, first);
+    std::getline(in, second);
+    ASSERT_FALSE(first.empty()) << "the discovery row past the file-size limit must fail";
+    const std::string cause = first.substr(first.rfind(": ") + 2);
+    EXPECT_FALSE(cause.empty()) << first;
+    // Either SQLite kept the batch and the trace finished with the error as its
+    // outcome, or it rolled the batch back and finish names the first failure.
+    if (!second.empty()) {
+        EXPECT_NE(second.find("a write failed earlier (" + cause + ")"), std::string::npos) << second;
+    } else {
+        const RecordedTrace trace = read_trace(dir / "trace.sqlite");
+        EXPECT_EQ(trace.meta.at("error"), first);
+    }
 }
 
 TEST(Judge, ATraceChangedAfterItsRunIsNotJudgedAsTheRuns) {
