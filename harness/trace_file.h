@@ -118,6 +118,7 @@ private:
     std::deque<PendingRow> queue_;
     bool writing_ = false;             // the writer holds rows taken off the queue
     bool stopping_ = false;
+    bool flush_ = false;               // sync() waits: write whatever is queued
     std::string writer_error_;
     // The first SQLite error on either thread, kept for finish(): a write that
     // failed on the caller's thread (a discovery row on a full disk) is caught
