@@ -71,8 +71,8 @@ constexpr std::uint64_t kRowsPerBatch = 4096;
 constexpr std::size_t kMaxQueuedRows = 16384;
 // The writer thread is woken when this many rows wait (or by sync()), not for
 // each round's first row: a wake per round was a thread hand-off per round, a
-// futex wake and two context switches, about a tenth of an in-process case's
-// CPU (perf, cases/table3-fusion --in-process).
+// futex wake and two context switches. Woken per 1024 rows, the paper suite in
+// process took 12.4 s of CPU instead of 14.8 s (README "Speed").
 constexpr std::size_t kRowsPerWake = 1024;
 
 }  // namespace
