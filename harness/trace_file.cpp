@@ -195,14 +195,14 @@ void TraceFile::set_meta(const std::string& key, const std::string& value) {
     if (rc != SQLITE_DONE) fail(sqlite3_errmsg(db_));
 }
 
-void TraceFile::append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json) {
+void TraceFile::append_text(TimeNs t, int round, const std::string& topic, std::string json_text) {
     if (db_ == nullptr) throw std::logic_error("trace " + file_.string() + ": append after finish");
     bool wake = false;
     {
         std::unique_lock lock(queue_mutex_);
         drained_.wait(lock, [this] { return queue_.size() < kMaxQueuedRows || !writer_error_.empty(); });
         if (!writer_error_.empty()) throw std::runtime_error(writer_error_);
-        queue_.push_back(PendingRow{t, round, topic, json});
+        queue_.push_back(PendingRow{t, round, topic, std::move(json_text)});
         wake = queue_.size() == kRowsPerWake;
     }
     if (wake) queued_.notify_one();
@@ -214,7 +214,7 @@ void TraceFile::write_row(const PendingRow& row) {
     const TimeNs t = row.t;
     const int round = row.round;
     const std::string& topic = row.topic;
-    const std::string text = row.json.dump();
+    const std::string& text = row.json_text;
     digest(std::to_string(t) + " " + std::to_string(round) + " " + topic + " " + text + "\n");
     sqlite3_bind_int64(insert_, 1, t);
     sqlite3_bind_int(insert_, 2, round);
@@ -231,12 +231,12 @@ void TraceFile::write_row(const PendingRow& row) {
 }
 
 void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, const std::string& participant,
-                               const std::string& guid_prefix, const nlohmann::json& json) {
+                               const std::string& guid_prefix, const std::string& json_text) {
     // Not in the digest: the run failed on it, and the digest stays what the
     // samples, the deposition and the landing edges alone give (rig judge
     // recomputes it from those tables).
     sync();
-    const std::string text = json.dump();
+    const std::string& text = json_text;
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO foreign_samples VALUES (?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {

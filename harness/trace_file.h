@@ -69,9 +69,17 @@ public:
 
     const std::filesystem::path& path() const { return file_; }
     void set_meta(const std::string& key, const std::string& value);
-    void append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json);
+    // A sample as JSON text, exactly as nlohmann::json::dump() writes it (the
+    // digest is taken over it; harness/trace_json.h writes it so).
+    void append_text(TimeNs t, int round, const std::string& topic, std::string json_text);
+    // The same from a JSON value (hand-made traces, tests).
+    void append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json) {
+        append_text(t, round, topic, json.dump());
+    }
+    // Text is not a JSON value: it would be stored as one JSON string (append_text takes text).
+    void append(TimeNs t, int round, const std::string& topic, const std::string& json_text) = delete;
     void append_foreign(TimeNs t, int round, const std::string& topic, const std::string& participant,
-                        const std::string& guid_prefix, const nlohmann::json& json);
+                        const std::string& guid_prefix, const std::string& json_text);
     void record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoint>& endpoints);
     void record_deposition(const emulators::DepositionGrid& grid);
     void record_landing_edges(const std::vector<emulators::LandingEdge>& edges);
@@ -88,7 +96,7 @@ private:
         TimeNs t = 0;
         int round = 0;
         std::string topic;
-        nlohmann::json json;
+        std::string json_text;
     };
     // Records the first SQLite error (see first_error_), then throws it naming the file.
     [[noreturn]] void fail(const std::string& sqlite_error);

@@ -25,9 +25,9 @@ template <class Msg>
 void TraceRecorder::add_channel(DdsContext& dds, const char* topic) {
     auto reader = std::make_shared<Reader<Msg>>(dds, topic);
     readers_.push_back(reader);
-    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<nlohmann::json, std::string>>& out) {
+    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<std::string, std::string>>& out) {
                                     for (auto& [sample, writer] : reader->take_all_with_writer()) {
-                                        out.emplace_back(to_json(sample), std::move(writer));
+                                        out.emplace_back(to_json_text(sample), std::move(writer));
                                     }
                                 }});
 }
@@ -90,35 +90,28 @@ void TraceRecorder::record_raw(const std::string& topic, const std::string& type
     }
     auto reader = std::make_shared<RawReader>(dds_, topic, type_name);
     readers_.push_back(reader);
-    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<nlohmann::json, std::string>>& out) {
-                                    static const char* digits = "0123456789abcdef";
+    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<std::string, std::string>>& out) {
                                     for (auto& [sample, writer] : reader->take_all_with_writer()) {
-                                        std::string hex;
-                                        hex.reserve(sample.bytes.size() * 2);
-                                        for (const unsigned char byte : sample.bytes) {
-                                            hex += digits[byte >> 4];
-                                            hex += digits[byte & 0xf];
-                                        }
-                                        out.emplace_back(nlohmann::json{{"cdr_hex", hex}}, std::move(writer));
+                                        out.emplace_back(cdr_hex_json_text(sample.bytes), std::move(writer));
                                     }
                                 }});
 }
 
 void TraceRecorder::drain(TimeNs t, int round) {
     bool controller_output = false;
-    std::vector<std::pair<nlohmann::json, std::string>> taken;
+    std::vector<std::pair<std::string, std::string>> taken;
     for (const Channel& channel : channels_) {
         taken.clear();
         channel.take(taken);
         const bool rig_only = rig_only_topic(channel.topic);
-        for (const auto& [json, writer] : taken) {
+        for (auto& [text, writer] : taken) {
             if (rig_only && !dds_.is_rig_participant(writer)) {
                 const std::string participant = dds_.participant_name(writer);
-                file_.append_foreign(t, round, channel.topic, participant, writer, json);
+                file_.append_foreign(t, round, channel.topic, participant, writer, text);
                 foreign_.push_back(ForeignSample{t, channel.topic, participant, writer});
                 continue;
             }
-            file_.append(t, round, channel.topic, json);
+            file_.append_text(t, round, channel.topic, std::move(text));
             if (channel.topic == topics::kVehicleTruth) last_vehicle_truth_ns_ = t;
             controller_output |= controller_output_topic(channel.topic);
         }
@@ -126,7 +119,7 @@ void TraceRecorder::drain(TimeNs t, int round) {
     // The plant at the instant the controller acted: the judge then needs no
     // interpolation (and no plant) to say where the sprayer was.
     if (controller_output && probe_ && last_vehicle_truth_ns_ != t) {
-        file_.append(t, round, topics::kVehicleTruth, to_json(probe_(t)));
+        file_.append_text(t, round, topics::kVehicleTruth, to_json_text(probe_(t)));
         last_vehicle_truth_ns_ = t;
     }
 }

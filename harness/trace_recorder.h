@@ -54,7 +54,8 @@ private:
     struct Channel {
         std::string topic;
         // Appends (json, writer's GUID prefix) of every sample taken.
-        std::function<void(std::vector<std::pair<nlohmann::json, std::string>>&)> take;
+        // (JSON text, writer GUID prefix) of each sample taken.
+        std::function<void(std::vector<std::pair<std::string, std::string>>&)> take;
     };
 public:
     // (Public for record_raw's table of known types.)

@@ -253,7 +253,7 @@ TEST(Judge, ForgedTruthIsNeverJudgedAndFailsTheCase) {
     HandMadeTrace made("truth-forger", continuation_plan());
     made.drive();
     made.trace().append_foreign(45 * kS, 0, rig::topics::kHydraulicsTruth, "controller", "010f0a0b0c0d0e0f00000000",
-                                {{"main_flow_l_min", 20.0}, {"sections_spraying_mask", 7}});
+                                nlohmann::json{{"main_flow_l_min", 20.0}, {"sections_spraying_mask", 7}}.dump());
     made.finish();
     const CaseRun run = made.judged();
     EXPECT_EQ(run.result.error_kind, "topic_role_violation");

@@ -178,7 +178,8 @@ TEST(NmeaWireFaults, RatesOutsideZeroToHundredAreRefused) {
 // ---------------------------------------------------------------- the reference controller
 
 std::filesystem::path fresh_state_dir(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("wire-faults-test-" + name + "-" + std::to_string(::getpid()));
+    // Under GoogleTest's temp dir (scripts/test's scratch folder), like every other test's files.
+    const auto dir = std::filesystem::path(::testing::TempDir()) / ("wire-faults-test-" + name + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;
