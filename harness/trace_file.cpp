@@ -236,7 +236,6 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
     // samples, the deposition and the landing edges alone give (rig judge
     // recomputes it from those tables).
     sync();
-    const std::string& text = json_text;
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT INTO foreign_samples VALUES (?, ?, ?, ?, ?, ?)", -1, &statement, nullptr) !=
         SQLITE_OK) {
@@ -247,7 +246,7 @@ void TraceFile::append_foreign(TimeNs t, int round, const std::string& topic, co
     sqlite3_bind_text(statement, 3, topic.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(statement, 4, participant.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(statement, 5, guid_prefix.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(statement, 6, text.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(statement, 6, json_text.c_str(), -1, SQLITE_TRANSIENT);
     const int rc = sqlite3_step(statement);
     sqlite3_finalize(statement);
     if (rc != SQLITE_DONE) fail(sqlite3_errmsg(db_));

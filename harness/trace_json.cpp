@@ -48,13 +48,10 @@ template <class Out>
 void fields(const msg::NmeaSentence& sample, Out& out) {
     out("sentence", without_line_end(sample.sentence().to_string()));
 }
-template <class Out>
-void fields(const msg::EncoderCount& sample, Out& out) {
-    out("count_pulses", sample.count_pulses());
-    out("last_edge_capture_us", sample.last_edge_capture_us());
-}
-template <class Out>
-void fields(const msg::FlowMeterCount& sample, Out& out) {
+// The wheel encoder and the KF11 meter count pulses alike (idl/device.idl).
+template <class Out, class Count,
+          std::enable_if_t<std::is_same_v<Count, msg::EncoderCount> || std::is_same_v<Count, msg::FlowMeterCount>, int> = 0>
+void fields(const Count& sample, Out& out) {
     out("count_pulses", sample.count_pulses());
     out("last_edge_capture_us", sample.last_edge_capture_us());
 }

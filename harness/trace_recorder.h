@@ -11,8 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "harness/trace_file.h"
 #include "rig/runtime/dds_context.h"
 
@@ -53,8 +51,7 @@ public:
 private:
     struct Channel {
         std::string topic;
-        // Appends (json, writer's GUID prefix) of every sample taken.
-        // (JSON text, writer GUID prefix) of each sample taken.
+        // Appends (JSON text, writer's GUID prefix) of every sample taken.
         std::function<void(std::vector<std::pair<std::string, std::string>>&)> take;
     };
 public:

@@ -8,7 +8,8 @@
 //  * flickering sections: the flow never settles (no small adjust time);
 //  * a truth reader, a truth forger: the case fails naming topic and participant;
 //  * a killed controller: the trace keeps its samples, the error its kind;
-//  * a trace edited after its run, or not a trace at all: refused, not judged.
+//  * a trace edited after its run, or not a trace at all: refused, not judged;
+//  * a trace write that failed (a full disk): finish() names the failure.
 #include <gtest/gtest.h>
 
 #include "run_support.h"
