@@ -90,6 +90,86 @@ void checked(const YamlSection& section, Build build) {
     }
 }
 
+field2d::CoverClass read_cover(const YamlSection& s, const char* key, field2d::CoverClass fallback) {
+    const std::string name = s.optional_enum(key, {"bare", "sparse", "normal"}, field2d::cover_class_name(fallback));
+    return name == "bare" ? field2d::CoverClass::bare : name == "sparse" ? field2d::CoverClass::sparse : field2d::CoverClass::normal;
+}
+
+void read_gains(const YamlSection& s, emulators::vision::ChannelGains& gains) {
+    read(s, "red", gains.red);
+    read(s, "green", gains.green);
+    read(s, "blue", gains.blue);
+}
+
+// The fields of CameraEmulatorParams a case may set for both cameras (the
+// geometry stays Sec. 1.1's; a knocked camera is a fault, not a new mounting).
+void read_camera_common(const YamlSection& s, emulators::vision::CameraEmulatorParams& camera) {
+    read(s, "noise_sd_dn", camera.noise_sd_dn);
+    read(s, "lighting_gain", camera.lighting_gain);
+    read_gains(s.section("lighting_cast"), camera.lighting_cast);
+    camera.samples_per_axis = s.optional_in_range<int>("samples_per_axis", camera.samples_per_axis, Bounds::closed(1, 8));
+    read(s, "frame_rate_hz", camera.frame_rate_hz);
+    const int width = s.optional_in_range<int>("width_px", camera.camera.intrinsics.width_px, Bounds::closed(16, 1920));
+    const int height = s.optional_in_range<int>("height_px", camera.camera.intrinsics.height_px, Bounds::closed(16, 1080));
+    if (width != camera.camera.intrinsics.width_px || height != camera.camera.intrinsics.height_px) {
+        // Another resolution is another sensor: the principal point moves to its centre, the focal length scales.
+        const double scale = static_cast<double>(width) / camera.camera.intrinsics.width_px;
+        camera.camera.intrinsics.fx_px *= scale;
+        camera.camera.intrinsics.fy_px *= scale;
+        camera.camera.intrinsics.cx_px = width / 2.0;
+        camera.camera.intrinsics.cy_px = height / 2.0;
+        camera.camera.intrinsics.width_px = width;
+        camera.camera.intrinsics.height_px = height;
+    }
+}
+
+void read_camera_faults(const YamlSection& s, emulators::vision::CameraFaults& faults) {
+    read(s, "pitch_offset_deg", faults.pitch_offset_deg);
+    faults.blur_radius_px = s.optional_in_range<int>("blur_radius_px", faults.blur_radius_px, Bounds::closed(0, 50));
+    read_gains(s.section("colour_cast"), faults.colour_cast);
+    const std::string dead = s.optional_enum("dead", {"none", "black_frame", "no_frame"}, "none");
+    faults.dead = dead == "black_frame" ? emulators::vision::DeadCamera::black_frame
+                  : dead == "no_frame"  ? emulators::vision::DeadCamera::no_frame
+                                        : emulators::vision::DeadCamera::none;
+}
+
+BoundaryVisionSpec read_vision(const YamlSection& s) {
+    BoundaryVisionSpec vision;
+    const YamlSection crop = s.section("crop");
+    field2d::CropCoverParams& c = vision.crop;
+    read(crop, "row_spacing_m", c.row_spacing_m);
+    read(crop, "row_bearing_deg", c.row_bearing_deg);
+    read(crop, "row_offset_m", c.row_offset_m);
+    read(crop, "row_scatter_m", c.row_scatter_m);
+    read(crop, "normal_plants_per_m", c.normal_plants_per_m);
+    read(crop, "sparse_plants_per_m", c.sparse_plants_per_m);
+    read(crop, "plant_height_min_m", c.plant_height_min_m);
+    read(crop, "plant_height_max_m", c.plant_height_max_m);
+    c.leaves_min = crop.optional_in_range<int>("leaves_min", c.leaves_min, Bounds::closed(1, 20));
+    c.leaves_max = crop.optional_in_range<int>("leaves_max", c.leaves_max, Bounds::closed(1, 20));
+    read(crop, "leaf_length_per_height_min", c.leaf_length_per_height_min);
+    read(crop, "leaf_length_per_height_max", c.leaf_length_per_height_max);
+    read(crop, "leaf_width_m", c.leaf_width_m);
+    c.default_cover = read_cover(crop, "default_cover", c.default_cover);
+    for (const YamlSection& patch : crop.list("patches")) {
+        std::vector<field2d::Vec2> corners;
+        for (const YamlSection& corner : patch.list("corners")) {
+            corners.push_back(field2d::Vec2{corner.required_in_range<double>("east_m", Bounds::closed(-1e5, 1e5)),
+                                            corner.required_in_range<double>("north_m", Bounds::closed(-1e5, 1e5))});
+        }
+        if (corners.size() < 3 || corners.size() > 64) patch.fail("corners", "a patch has 3 to 64 corners");
+        const field2d::CoverClass cover = read_cover(patch, "cover", field2d::CoverClass::normal);
+        checked(patch, [&] { c.patches.push_back(field2d::CoverPatch{field2d::Polygon(corners, "patch"), cover}); });
+    }
+    if (c.patches.size() > 64) crop.fail("patches", "at most 64 patches");
+    const YamlSection cameras = s.section("cameras");
+    read_camera_common(cameras, vision.left);
+    read_camera_common(cameras, vision.right);
+    read_camera_faults(s.section("left").section("faults"), vision.left.faults);
+    read_camera_faults(s.section("right").section("faults"), vision.right.faults);
+    return vision;
+}
+
 }  // namespace
 
 field2d::NozzleFlowTable BoundaryCaseSpec::flow_table_or_paper() const {
@@ -160,6 +240,8 @@ BoundaryCaseSpec read_boundary_case(const YamlSection& root) {
     read(laser, "accuracy_base_m", spec.laser.accuracy_base_m);
     read(laser, "accuracy_per_m", spec.laser.accuracy_per_m);
 
+    if (root.has("vision")) spec.vision = read_vision(root.section("vision"));
+
     const YamlSection judge = root.required_section("judge");
     const YamlSection ground = judge.section("ground");
     read(ground, "east_min_m", spec.ground.east_min_m);
@@ -181,8 +263,42 @@ BoundaryCaseSpec read_boundary_case(const YamlSection& root) {
     spec.judge_centre_rule = judge.optional<bool>("centre_rule", spec.judge_centre_rule);
     spec.end_after_route_s =
         judge.optional_in_range<double>("end_after_route_s", spec.end_after_route_s, Bounds::closed(0, 600));
-    if (spec.edges.empty() && !spec.judge_flow_per_duty && !spec.judge_centre_rule) {
-        judge.fail("judge nothing? give `edges`, `flow_per_duty: true` or `centre_rule: true`");
+    if (spec.vision) {
+        VisionJudging& v = spec.vision_judging;
+        v.enabled = true;
+        const YamlSection zone = judge.section("vision").section("zone");
+        read(zone, "east_min_m", v.east_min_m);
+        read(zone, "east_max_m", v.east_max_m);
+        read(zone, "north_min_m", v.north_min_m);
+        read(zone, "north_max_m", v.north_max_m);
+        if (!(v.east_min_m < v.east_max_m && v.north_min_m < v.north_max_m)) zone.fail("the zone's min must be below its max");
+        v.decision_delay_s = judge.section("vision").optional_in_range<double>("decision_delay_s", v.decision_delay_s,
+                                                                                Bounds::closed(0, 10));
+        v.eq14.k_max_cover = judge.section("vision").optional_in_range<double>("k_max_cover", v.eq14.k_max_cover,
+                                                                               Bounds::open_closed(0, 1));
+    } else if (judge.has("vision")) {
+        judge.fail("vision", "judging vision needs the case's `vision:` section (the cameras)");
+    }
+    for (const YamlSection& paper : judge.list("papers")) {
+        spec.papers.push_back(field2d::Vec2{paper.required_in_range<double>("east_m", Bounds::closed(-1e5, 1e5)),
+                                            paper.required_in_range<double>("north_m", Bounds::closed(-1e5, 1e5))});
+    }
+    if (spec.papers.size() > 64) judge.fail("papers", "at most 64 papers");
+    if (judge.has("dose_strip")) {
+        const YamlSection strip = judge.section("dose_strip");
+        GroundRect r;
+        r.east_min_m = strip.required_in_range<double>("east_min_m", Bounds::closed(-1e5, 1e5));
+        r.east_max_m = strip.required_in_range<double>("east_max_m", Bounds::closed(-1e5, 1e5));
+        r.north_min_m = strip.required_in_range<double>("north_min_m", Bounds::closed(-1e5, 1e5));
+        r.north_max_m = strip.required_in_range<double>("north_max_m", Bounds::closed(-1e5, 1e5));
+        if (!(r.east_min_m < r.east_max_m && r.north_min_m < r.north_max_m)) strip.fail("the strip's min must be below its max");
+        spec.dose_strip = r;
+    }
+    spec.coverage.stain_area_cm2_per_ul = judge.optional_in_range<double>(
+        "stain_area_cm2_per_ul", spec.coverage.stain_area_cm2_per_ul, Bounds::open_closed(0, 100));
+    if (spec.edges.empty() && !spec.judge_flow_per_duty && !spec.judge_centre_rule && !spec.vision && spec.papers.empty() &&
+        !spec.dose_strip) {
+        judge.fail("judge nothing? give `edges`, `flow_per_duty: true`, `centre_rule: true`, `papers`, `dose_strip` or a `vision:` section");
     }
     return spec;
 }
@@ -215,6 +331,14 @@ void check_boundary_case(const BoundaryCaseSpec& spec, const YamlSection& root) 
     checked(root.section("ad300"), [&] { emulators::Ad300Receiver(*kinematics, spec.ad300); });
     checked(root.section("laser"), [&] { emulators::L4LaserSensor(*kinematics, spec.laser); });
     checked(root.section("judge").section("ground"), [&] { field2d::DepositionGrid2d grid(spec.ground); });
+    if (spec.vision) {
+        checked(root.section("vision").section("crop"), [&] { field2d::validate(spec.vision->crop); });
+        checked(root.section("vision").section("left"), [&] { emulators::vision::validate(spec.vision->left, "vision.left"); });
+        checked(root.section("vision").section("right"), [&] { emulators::vision::validate(spec.vision->right, "vision.right"); });
+        if (spec.mounting.nozzle_count % 2 != 0) {
+            root.section("sprayer").fail("nozzle_count", "two cameras see half the boom each: an even nozzle count");
+        }
+    }
 }
 
 RawYaml controller_section_with_area(const RawYaml& controller, const BoundaryCaseSpec& spec) {
@@ -223,6 +347,8 @@ RawYaml controller_section_with_area(const RawYaml& controller, const BoundaryCa
     // controller's own errors still point at the case file's lines.
     if (!(controller.present && controller.node.IsMap())) out.node = YAML::Node(YAML::NodeType::Map);
     out.present = true;
+    // The cameras are on the rig: the reference controller uses them unless told otherwise.
+    if (spec.vision && !out.node["vision"]) out.node["vision"]["enabled"] = true;
     if (out.node["areas"]) return out;
     YAML::Node area;
     area["name"] = spec.area_name;

@@ -11,14 +11,22 @@
 //   sprayer:  mounting (antenna, nozzles, Eq. 18's lift) and boom_height: [ { t_s, height_m } ]
 //   spray:    fan and deposition step; flow_table: per nozzle [ { duty_pct, flow_ml_min } ] (Table 3 by default)
 //   valves:   PWM valves; ad300: the receiver; laser: the L4
+//   vision:   the crop truth and the two boom cameras (seed 001's vision half,
+//             docs/seed001-vision.md): crop: {CropCoverParams fields,
+//             default_cover, patches: [ { cover, corners: [ { east_m, north_m } ] } ]},
+//             cameras: {CameraEmulatorParams fields for both}, left: / right:
+//             { faults: { pitch_offset_deg, blur_radius_px, colour_cast, dead } }
 //   judge:    ground grid, wet threshold, the edges to measure and the metric
 //             each gives, flow per duty (Table 3), centre_rule (Sec. 4.2's
-//             boom-centre rule, Table 8 "along, boom centre outside")
+//             boom-centre rule, Table 8 "along, boom centre outside"), vision
+//             (density and level per frame in a zone) and papers (Tables 4-6's
+//             water-sensitive papers: coverage at points)
 // Every parameter is declared once, in the emulator's own parameter struct
 // (emulators/ad300_receiver.h, l4_laser_sensor.h, pwm_nozzle_valves.h,
 // boundary_spray_plant.h, field2d/*), with unit, default and provenance; the
 // case file overrides it by the same name, and the emulator's own checks give
 // the bounds (reported at the key's section as a rig::ConfigError).
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -32,7 +40,10 @@
 #include "emulators/field2d/sprayer_kinematics.h"
 #include "emulators/l4_laser_sensor.h"
 #include "emulators/pwm_nozzle_valves.h"
+#include "emulators/vision/camera_emulator.h"
+#include "emulators/field2d/crop_cover_map.h"
 #include "harness/boundary_metrics.h"
+#include "harness/vision_metrics.h"
 #include "rig/config/yaml_fields.h"
 
 namespace rig::harness {
@@ -45,6 +56,15 @@ struct BoundaryEdgeJudging {
     std::string metric;                    // one of kBoundaryEdgeMetrics
     field2d::Vec2 near;                    // the area edge whose midpoint is nearest this point (local frame, m)
     EdgeProbe probe;                       // stations along the edge from its first corner (counter-clockwise)
+};
+
+// Seed 001's vision half: the crop the cameras see and the cameras themselves.
+struct BoundaryVisionSpec {
+    field2d::CropCoverParams crop;         // seed: the run's; patches in the local frame
+    // Left (index 0, nozzles 0 .. n/2 - 1) and right (the rest): Sec. 1.1's
+    // two cameras, seed001_camera_params() unless the case says otherwise.
+    emulators::vision::CameraEmulatorParams left = emulators::vision::seed001_camera_params(false);
+    emulators::vision::CameraEmulatorParams right = emulators::vision::seed001_camera_params(true);
 };
 
 struct BoundaryCaseSpec {
@@ -61,6 +81,7 @@ struct BoundaryCaseSpec {
     emulators::PwmValveParams valves;      // seed: the run's
     emulators::Ad300Params ad300;          // seed: the run's
     emulators::L4LaserParams laser;        // seed: the run's
+    std::optional<BoundaryVisionSpec> vision;  // absent: no cameras (the area's density is the controller's)
     // Judging.
     field2d::DepositionGrid2dParams ground;  // the judge's grid, rebuilt from the trace
     double wet_threshold_ul_cm2 = EdgeProbe{}.wet_threshold_ul_cm2;
@@ -71,6 +92,10 @@ struct BoundaryCaseSpec {
     // Sec. 4.2's boom-centre rule from truth (centre_out_* metrics, harness/boundary_metrics.h).
     bool judge_centre_rule = false;
     double end_after_route_s = 1.0;        // the run ends this long after the route does, [0, 600]
+    VisionJudging vision_judging;          // with `vision:`: the density and level checks (harness/vision_metrics.h)
+    std::vector<field2d::Vec2> papers;     // water-sensitive papers (Tables 4-6), their centres, local frame
+    std::optional<GroundRect> dose_strip;  // dose per area over this rectangle (local frame)
+    CoverageModel coverage;                // how a dose becomes paper coverage (harness/vision_metrics.h)
 
     field2d::NozzleFlowTable flow_table_or_paper() const;
     field2d::LocalFrame frame() const { return field2d::LocalFrame(origin.lat_deg, origin.lon_deg, origin.height_m); }

@@ -64,6 +64,10 @@ BoundaryJudgingPlan plan_boundary_judging(const BoundaryCaseSpec& spec) {
     for (int n = 0; n < table.nozzle_count(); ++n) plan.flow_table.push_back(table.points(n));
     plan.centre_rule = spec.judge_centre_rule;
     plan.area = area.vertices();
+    plan.vision = spec.vision_judging;
+    plan.papers = spec.papers;
+    plan.dose_strip = spec.dose_strip;
+    plan.coverage = spec.coverage;
     return plan;
 }
 
@@ -87,7 +91,7 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
     }
     nlohmann::json area = nlohmann::json::array();
     for (const field2d::Vec2& v : plan.area) area.push_back({v.east_m, v.north_m});
-    return {{"ground",
+    nlohmann::json json = {{"ground",
              {{"east_min_m", plan.ground.east_min_m},
               {"east_max_m", plan.ground.east_max_m},
               {"north_min_m", plan.ground.north_min_m},
@@ -103,6 +107,27 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
             {"flow_table_ml_min", std::move(table)},
             {"centre_rule", plan.centre_rule},
             {"area", std::move(area)}};
+    // Only cases that judge vision or papers carry these keys (older plans stay byte for byte).
+    if (plan.vision.enabled) {
+        const VisionJudging& v = plan.vision;
+        const Eq14Levels& e = v.eq14;
+        json["vision"] = {{"zone", {v.east_min_m, v.east_max_m, v.north_min_m, v.north_max_m}},
+                          {"decision_delay_s", v.decision_delay_s},
+                          {"eq14", {e.k_max_cover, e.eq12_coefficient_l_min_per_m_s, e.eq13_slope_l_min_per_pct,
+                                    e.eq13_intercept_l_min, e.level0_max_pct, e.level1_max_pct, e.level1_duty_pct,
+                                    e.level2_duty_pct}}};
+    }
+    if (!plan.papers.empty() || plan.dose_strip) {
+        nlohmann::json papers = nlohmann::json::array();
+        for (const field2d::Vec2& p : plan.papers) papers.push_back({p.east_m, p.north_m});
+        json["papers"] = std::move(papers);
+        json["stain_area_cm2_per_ul"] = plan.coverage.stain_area_cm2_per_ul;
+        if (plan.dose_strip) {
+            const GroundRect& r = *plan.dose_strip;
+            json["dose_strip"] = {r.east_min_m, r.east_max_m, r.north_min_m, r.north_max_m};
+        }
+    }
+    return json;
 }
 
 BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) {
@@ -143,6 +168,28 @@ BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) 
         if (json.contains("centre_rule")) plan.centre_rule = json.at("centre_rule").get<bool>();
         if (json.contains("area")) {
             for (const nlohmann::json& v : json.at("area")) plan.area.push_back({v.at(0).get<double>(), v.at(1).get<double>()});
+        }
+        if (json.contains("vision")) {
+            const nlohmann::json& v = json.at("vision");
+            const std::vector<double> zone = at(v, "zone", "vision.").get<std::vector<double>>();
+            const std::vector<double> eq = at(v, "eq14", "vision.").get<std::vector<double>>();
+            if (zone.size() != 4 || eq.size() != 8) throw std::runtime_error("boundary judging plan: vision.zone needs 4 numbers, vision.eq14 8");
+            plan.vision.enabled = true;
+            plan.vision.east_min_m = zone[0];
+            plan.vision.east_max_m = zone[1];
+            plan.vision.north_min_m = zone[2];
+            plan.vision.north_max_m = zone[3];
+            plan.vision.decision_delay_s = at(v, "decision_delay_s", "vision.").get<double>();
+            plan.vision.eq14 = Eq14Levels{eq[0], eq[1], eq[2], eq[3], eq[4], eq[5], eq[6], eq[7]};
+        }
+        if (json.contains("papers")) {
+            for (const nlohmann::json& p : json.at("papers")) plan.papers.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+            plan.coverage.stain_area_cm2_per_ul = at(json, "stain_area_cm2_per_ul", "").get<double>();
+        }
+        if (json.contains("dose_strip")) {
+            const std::vector<double> r = json.at("dose_strip").get<std::vector<double>>();
+            if (r.size() != 4) throw std::runtime_error("boundary judging plan: dose_strip needs 4 numbers");
+            plan.dose_strip = GroundRect{r[0], r[1], r[2], r[3]};
         }
         if (plan.centre_rule && plan.area.size() < 3) {
             throw std::runtime_error("boundary judging plan: centre_rule needs `area` with at least 3 corners");
@@ -250,9 +297,111 @@ std::vector<FlowRecord> flow_records_from_truth(const std::vector<NozzleStepTrut
     return records;
 }
 
+std::vector<RoiJudged> rois_from_trace(const RecordedTrace& trace, const VisionJudging& judging) {
+    const auto samples = [&](const char* topic) -> const std::vector<RecordedSample>& {
+        static const std::vector<RecordedSample> none;
+        const auto it = trace.samples.find(topic);
+        return it == trace.samples.end() ? none : it->second;
+    };
+    // The controller's reports by (camera, frame number); the first one counts.
+    std::map<std::pair<int, long>, const nlohmann::json*> reports;
+    for (const RecordedSample& s : samples(topics::kVisionReport)) {
+        reports.emplace(std::make_pair(s.json.at("camera").get<int>(), s.json.at("frame_number").get<long>()), &s.json);
+    }
+    // The duties commanded, in time order (the trace's round time is when the plant could take them).
+    std::vector<std::pair<TimeNs, std::vector<double>>> duties;
+    for (const RecordedSample& s : samples(topics::kNozzlePwm)) {
+        duties.emplace_back(s.t_ns, s.json.at("duty_pct").get<std::vector<double>>());
+    }
+    std::stable_sort(duties.begin(), duties.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const TimeNs delay = seconds_to_ns(judging.decision_delay_s);
+    std::vector<RoiJudged> rois;
+    for (const RecordedSample& s : samples(topics::kCameraViewTruth)) {
+        const nlohmann::json& view = s.json;
+        const TimeNs t_ns = view.at("time_ns").get<TimeNs>();
+        const int camera = view.at("camera").get<int>();
+        const long frame = view.at("frame_number").get<long>();
+        const auto report = reports.find({camera, frame});
+        // The last command at or before the decision instant.
+        const auto after = std::upper_bound(duties.begin(), duties.end(), t_ns + delay,
+                                            [](TimeNs t, const auto& d) { return t < d.first; });
+        for (const nlohmann::json& n : view.at("nozzles")) {
+            const double east = n.at("roi_centre_east_m").get<double>();
+            const double north = n.at("roi_centre_north_m").get<double>();
+            if (!(east >= judging.east_min_m && east <= judging.east_max_m && north >= judging.north_min_m &&
+                  north <= judging.north_max_m)) {
+                continue;
+            }
+            RoiJudged roi;
+            roi.t_s = ns_to_seconds(t_ns);
+            roi.camera = camera;
+            roi.frame_number = frame;
+            roi.nozzle = n.at("nozzle").get<int>();
+            roi.true_density = n.at("density").get<double>();
+            roi.true_speed_m_s = view.at("speed_m_s").get<double>();
+            roi.delivered = view.at("delivered").get<bool>();
+            if (report != reports.end()) {
+                roi.reported = true;
+                for (const nlohmann::json& r : report->second->at("nozzles")) {
+                    if (r.at("nozzle").get<int>() != roi.nozzle || !r.at("measured").get<bool>()) continue;
+                    roi.measured = true;
+                    roi.measured_density = r.at("density").get<double>();
+                }
+            }
+            if (after != duties.begin()) {
+                const std::vector<double>& duty = std::prev(after)->second;
+                if (static_cast<std::size_t>(roi.nozzle) < duty.size()) roi.duty_pct = duty[static_cast<std::size_t>(roi.nozzle)];
+            }
+            rois.push_back(roi);
+        }
+    }
+    return rois;
+}
+
+DoseCells dose_cells(const DoseRaster& total, const GroundRect& rect, const std::string& what) {
+    const double east_max = total.east0_m + total.cell_m * static_cast<double>(total.nx);
+    const double north_max = total.north0_m + total.cell_m * static_cast<double>(total.ny);
+    if (!(rect.east_min_m >= total.east0_m && rect.east_max_m <= east_max && rect.north_min_m >= total.north0_m &&
+          rect.north_max_m <= north_max)) {
+        throw std::runtime_error(what + " (east " + std::to_string(rect.east_min_m) + " .. " + std::to_string(rect.east_max_m) +
+                                 " m, north " + std::to_string(rect.north_min_m) + " .. " + std::to_string(rect.north_max_m) +
+                                 " m) reaches off the judge's ground grid");
+    }
+    DoseCells cells;
+    for (std::size_t iy = 0; iy < total.ny; ++iy) {
+        const double north = total.north0_m + (static_cast<double>(iy) + 0.5) * total.cell_m;
+        if (north < rect.north_min_m || north > rect.north_max_m) continue;
+        for (std::size_t ix = 0; ix < total.nx; ++ix) {
+            const double east = total.east0_m + (static_cast<double>(ix) + 0.5) * total.cell_m;
+            if (east < rect.east_min_m || east > rect.east_max_m) continue;
+            cells.dose_ul_cm2.push_back(total.dose_ul_cm2[iy * total.nx + ix]);
+        }
+    }
+    return cells;
+}
+
 MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgingPlan& plan) {
     MetricSet metrics;
     const std::vector<NozzleStepTruth> steps = nozzle_step_truth(trace);
+    if (plan.vision.enabled) {
+        for (const auto& [name, value] : vision_metrics(rois_from_trace(trace, plan.vision), plan.vision, metrics.not_measured)) {
+            metrics.values[name] = value;
+        }
+    }
+    if (!plan.papers.empty() || plan.dose_strip) {
+        const DoseRaster total = sum_rasters(ground_from_truth(steps, plan));
+        std::vector<DoseCells> papers;
+        for (std::size_t i = 0; i < plan.papers.size(); ++i) {
+            papers.push_back(dose_cells(total, paper_at(plan.papers[i].east_m, plan.papers[i].north_m),
+                                        "papers[" + std::to_string(i) + "]"));
+        }
+        for (const auto& [name, value] : paper_metrics(papers, plan.coverage)) metrics.values[name] = value;
+        if (plan.dose_strip) {
+            for (const auto& [name, value] : strip_metrics(dose_cells(total, *plan.dose_strip, "dose_strip"), plan.coverage)) {
+                metrics.values[name] = value;
+            }
+        }
+    }
     if (!plan.edges.empty()) {
         const std::vector<DoseRaster> layers = ground_from_truth(steps, plan);
         const DoseRaster total = sum_rasters(layers);

@@ -8,6 +8,7 @@
 // height of that instant. The metrics are then harness/boundary_metrics.h's.
 // What to measure (the ground grid, the edges, the flow table) is the plan the
 // run wrote from the case file into meta `judging`, key `boundary`.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "harness/boundary_metrics.h"
 #include "harness/judge.h"
 #include "harness/metrics.h"
+#include "harness/vision_metrics.h"
 
 namespace rig::harness {
 
@@ -39,6 +41,10 @@ struct BoundaryJudgingPlan {
     std::vector<std::vector<field2d::FlowPoint>> flow_table;  // what the plant was given (Table 3)
     bool centre_rule = false;
     std::vector<field2d::Vec2> area;       // local frame, counter-clockwise; the centre rule's area
+    VisionJudging vision;                  // seed 001's vision half (harness/vision_metrics.h)
+    std::vector<field2d::Vec2> papers;     // Tables 4-6's papers (centres), local frame
+    std::optional<GroundRect> dose_strip;  // dose per area judged over it
+    CoverageModel coverage;
 };
 
 // From the case: the area's edges in the local frame (its corners through the
@@ -66,6 +72,15 @@ std::vector<DoseRaster> ground_from_truth(const std::vector<NozzleStepTruth>& st
 // What each nozzle delivered at each duty it held (after flow_settle_s, over a
 // whole number of PWM periods).
 std::vector<FlowRecord> flow_records_from_truth(const std::vector<NozzleStepTruth>& steps, const BoundaryJudgingPlan& plan);
+
+// Every ROI of every frame whose true centre lies in the plan's vision zone:
+// truth/camera_view against controller/vision/density and the duty of
+// actuator/nozzle_pwm/duty decision_delay_s after the exposure. Throws
+// std::runtime_error naming a malformed sample.
+std::vector<RoiJudged> rois_from_trace(const RecordedTrace& trace, const VisionJudging& judging);
+// The cells of `total` whose centres lie in `rect`; a rectangle reaching off
+// the raster throws std::runtime_error naming `what`.
+DoseCells dose_cells(const DoseRaster& total, const GroundRect& rect, const std::string& what);
 
 // Every boundary metric of the plan from the trace.
 MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgingPlan& plan);

@@ -3,6 +3,7 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "harness/board_attach.h"
@@ -102,6 +103,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                                  dds_security_environment(options.dds_security_dir, kControllerIdentity));
         TraceRecorder trace(dds, trace_file);
         trace.record_boundary_topics();
+        if (boundary.vision) trace.record_vision_topics();
         trace.file().set_meta("case", run_name);
         trace.file().set_meta("case_file", spec.source_path.string());
         trace.file().set_meta("case_yaml", spec.source_text);
@@ -122,6 +124,23 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         L4LaserNode laser(world.kinematics, world.laser);
         // The bench wires' adapters (real time only), after the devices whose lines they carry.
         std::vector<Node*> nodes = {&plant, &ad300, &laser};
+        // Seed 001's cameras: the left one sees the first half of the nozzles (Sec. 1.1).
+        std::vector<std::unique_ptr<CameraNode>> cameras;
+        if (world.vision) {
+            const int count = boundary.mounting.nozzle_count;
+            for (int camera = 0; camera < 2; ++camera) {
+                std::vector<int> nozzles;
+                std::vector<double> right_m;
+                for (int n = camera * count / 2; n < (camera + 1) * count / 2; ++n) {
+                    nozzles.push_back(n);
+                    right_m.push_back((n - 0.5 * (count - 1)) * boundary.mounting.nozzle_spacing_m);
+                }
+                cameras.push_back(std::make_unique<CameraNode>(world.kinematics, *world.crop,
+                                                               camera == 0 ? world.vision->left : world.vision->right,
+                                                               seed, camera, nozzles, right_m));
+                nodes.push_back(cameras.back().get());
+            }
+        }
         BenchWires& wires = session.wires();
         std::optional<NmeaSerialAdapter> nmea_adapter;
         std::optional<LaserSerialAdapter> laser_adapter;
@@ -192,6 +211,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                                                         {"startup_wall_seconds", startup_wall_s}};
         run_facts["in_process_refused"] = asked_in_process ? "seed 001's boundary controller has no plugin" : "";
         run_facts["plant_rejected_duty_commands"] = plant.rejected_commands();
+        for (const auto& camera : cameras) run_facts[camera->name() + "_frames"] = camera->frames_rendered();
         if (pwm_capture) run_facts["nozzle_pwm_captured"] = pwm_capture->published();
         trace.file().set_meta("run", run_facts.dump());
         trace.file().finish(outcome);

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <openssl/evp.h>
 
 #include "idl/topics.h"
 
@@ -19,6 +22,10 @@ BoundaryWorld::BoundaryWorld(const BoundaryCaseSpec& spec, std::uint64_t seed)
     ad300.seed = seed;
     laser.seed = seed;
     end_ns = seconds_to_ns(kinematics.route().end_time_s() + spec.end_after_route_s);
+    if (spec.vision) {
+        vision = spec.vision;
+        crop.emplace(spec.vision->crop, seed);
+    }
 }
 
 // ---------------------------------------------------------------- plant
@@ -150,6 +157,89 @@ TimeNs L4LaserNode::step(TimeNs now_ns) {
         writer_->publish(sample);
     }
     return sensor_.next_due_ns();
+}
+
+// ---------------------------------------------------------------- cameras
+
+namespace {
+
+std::string sha256_hex(const std::vector<std::uint8_t>& bytes) {
+    unsigned char hash[EVP_MAX_MD_SIZE];
+    unsigned int length = 0;
+    if (EVP_Digest(bytes.data(), bytes.size(), hash, &length, EVP_sha256(), nullptr) != 1) {
+        throw std::runtime_error("camera frame: SHA-256 failed");
+    }
+    static const char* digits = "0123456789abcdef";
+    std::string hex;
+    for (unsigned int i = 0; i < length; ++i) {
+        hex += digits[hash[i] >> 4];
+        hex += digits[hash[i] & 15];
+    }
+    return hex;
+}
+
+}  // namespace
+
+CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
+                       emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
+                       std::vector<int> nozzles, std::vector<double> nozzle_right_m)
+    : name_(camera_index == 0 ? "camera_left" : "camera_right"),
+      kinematics_(kinematics),
+      crop_(crop),
+      emulator_(params, seed, static_cast<std::uint64_t>(camera_index), name_),
+      camera_index_(camera_index),
+      nozzles_(std::move(nozzles)),
+      nozzle_right_m_(std::move(nozzle_right_m)),
+      frame_rate_hz_(params.frame_rate_hz) {}
+
+void CameraNode::configure(DdsContext& dds) {
+    frame_writer_ = std::make_unique<Writer<msg::CameraFrame>>(
+        dds, camera_index_ == 0 ? topics::kCameraLeftFrame : topics::kCameraRightFrame);
+    truth_writer_ = std::make_unique<Writer<msg::CameraViewTruth>>(dds, topics::kCameraViewTruth);
+}
+
+TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
+    // Exact on the nanosecond grid for every rate (no drift from adding a rounded period).
+    return static_cast<TimeNs>(std::llround(static_cast<double>(k) * 1e9 / frame_rate_hz_));
+}
+
+TimeNs CameraNode::step(TimeNs now_ns) {
+    while (frame_time_ns(frame_count_) <= now_ns) {
+        const TimeNs t_ns = frame_time_ns(frame_count_);
+        const field2d::SprayerTruth truth = kinematics_.truth_at(ns_to_seconds(t_ns));
+        const emulators::vision::BoomPose pose = emulators::vision::boom_pose_of(truth);
+        const std::optional<rig::camera::RgbImage> image = emulator_.render(crop_, pose, frame_count_);
+
+        msg::CameraViewTruth view;
+        view.time_ns(t_ns);
+        view.camera(static_cast<std::uint16_t>(camera_index_));
+        view.frame_number(static_cast<std::uint32_t>(frame_count_));
+        view.delivered(image.has_value());
+        view.speed_m_s(truth.pose.speed_m_s);
+        view.boom_height_m(truth.boom_height_m);
+        for (std::size_t i = 0; i < nozzles_.size(); ++i) {
+            const std::array<field2d::Vec2, 4> roi =
+                field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, nozzle_right_m_[i]);
+            msg::NozzleRoiTruth nozzle;
+            nozzle.nozzle(static_cast<std::uint16_t>(nozzles_[i]));
+            nozzle.density(crop_.cover_fraction(roi));
+            nozzle.roi_centre_east_m((roi[0].east_m + roi[1].east_m + roi[2].east_m + roi[3].east_m) / 4.0);
+            nozzle.roi_centre_north_m((roi[0].north_m + roi[1].north_m + roi[2].north_m + roi[3].north_m) / 4.0);
+            view.nozzles().push_back(nozzle);
+        }
+        if (image) {
+            view.rgb_sha256(sha256_hex(image->bytes));
+            msg::CameraFrame frame;
+            frame.frame_number(static_cast<std::uint32_t>(frame_count_));
+            frame.width_px(static_cast<std::uint16_t>(image->width));
+            frame.height_px(static_cast<std::uint16_t>(image->height));
+            frame.rgb(image->bytes);
+            frame_writer_->publish(frame);
+        }
+        truth_writer_->publish(view);
+        ++frame_count_;
+    }
+    return frame_time_ns(frame_count_);
 }
 
 }  // namespace rig::harness

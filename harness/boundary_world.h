@@ -7,10 +7,14 @@
 //                      publishes the truth the judge rebuilds the ground from
 //                      (truth/vehicle2d, truth/nozzles);
 //   Ad300Node          the AD300's RMC lines on device/gnss/nmea;
-//   L4LaserNode        the L4 laser's lines on device/laser_height/serial.
+//   L4LaserNode        the L4 laser's lines on device/laser_height/serial;
+//   CameraNode x 2     with `vision:`, each boom camera's frames on
+//                      device/camera_left|right/frame and the crop truth under
+//                      its nozzles' ROIs on truth/camera_view.
 // A pure function of the case and the seed: same seed, same trace.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +23,8 @@
 #include "emulators/field2d/sprayer_kinematics.h"
 #include "emulators/l4_laser_sensor.h"
 #include "emulators/pwm_nozzle_valves.h"
+#include "emulators/field2d/crop_cover_map.h"
+#include "emulators/vision/camera_emulator.h"
 #include "harness/boundary_case.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
@@ -31,6 +37,9 @@ struct BoundaryWorld {
     emulators::PwmValveParams valves;
     emulators::Ad300Params ad300;
     emulators::L4LaserParams laser;
+    // With `vision:`: the crop truth (seeded by the run's seed) and the cameras.
+    std::optional<field2d::CropCoverMap> crop;
+    std::optional<BoundaryVisionSpec> vision;
     TimeNs end_ns = 0;
 };
 
@@ -98,6 +107,40 @@ private:
     std::string name_ = "l4_laser";
     emulators::L4LaserSensor sensor_;
     std::unique_ptr<Writer<msg::SerialLine>> writer_;
+};
+
+// One boom camera (emulators/vision/camera_emulator.h). At each frame instant,
+// k / frame_rate_hz from t = 0, it renders the ground under the plant's true
+// boom pose and publishes the frame on its device topic (none when the camera
+// is dead with no_frame), and on truth/camera_view the true cover D of each of
+// its nozzles' Sec. 2.1 ROIs (from the plant's true nozzle points; the
+// controller's ROIs are its own estimate of these) with the frame's SHA-256.
+class CameraNode final : public Node {
+public:
+    // camera_index 0 = left (device/camera_left/frame), 1 = right; `nozzles`
+    // the nozzle numbers it sees; nozzle_right_m each one's place across the boom.
+    CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
+               emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
+               std::vector<int> nozzles, std::vector<double> nozzle_right_m);
+    const std::string& name() const override { return name_; }
+    void configure(DdsContext& dds) override;
+    TimeNs step(TimeNs now_ns) override;
+    std::uint64_t frames_rendered() const { return frame_count_; }
+
+private:
+    TimeNs frame_time_ns(std::uint64_t k) const;
+
+    std::string name_;
+    const field2d::SprayerKinematics& kinematics_;
+    const field2d::CropCoverMap& crop_;
+    emulators::vision::CameraEmulator emulator_;
+    int camera_index_;
+    std::vector<int> nozzles_;
+    std::vector<double> nozzle_right_m_;
+    double frame_rate_hz_;
+    std::uint64_t frame_count_ = 0;
+    std::unique_ptr<Writer<msg::CameraFrame>> frame_writer_;
+    std::unique_ptr<Writer<msg::CameraViewTruth>> truth_writer_;
 };
 
 }  // namespace rig::harness

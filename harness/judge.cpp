@@ -125,6 +125,7 @@ const std::set<std::string>& judged_topics() {
         topics::kVehicleTruth,     topics::kHydraulicsTruth,  topics::kSectionValves,
         topics::kBreakpointEvent,  topics::kControllerStatus, topics::kMainFlowMeter,
         topics::kVehicle2dTruth,   topics::kNozzlesTruth,     topics::kGnssNmea,  // GNSS wire faults
+        topics::kNozzlePwm,        topics::kVisionReport,     topics::kCameraViewTruth,  // seed 001's vision
     };
     return topics;
 }

@@ -174,6 +174,42 @@ void fields(const msg::NozzlesTruth& sample, Out& out) {
     out("time_ns", sample.time_ns());
     out("nozzles", sample.nozzles());
 }
+template <class Out>
+void fields(const msg::NozzleDensityReport& nozzle, Out& out) {
+    out("nozzle", nozzle.nozzle());
+    out("measured", nozzle.measured());
+    out("density", nozzle.density());
+    out("level", nozzle.level());
+}
+template <class Out>
+void fields(const msg::VisionReport& sample, Out& out) {
+    out("time_ns", sample.time_ns());
+    out("camera", sample.camera());
+    out("frame_number", sample.frame_number());
+    out("status", sample.status().to_string());
+    out("threshold", sample.threshold());
+    out("speed_m_s", sample.speed_m_s());
+    out("boom_height_m", sample.boom_height_m());
+    out("nozzles", sample.nozzles());
+}
+template <class Out>
+void fields(const msg::NozzleRoiTruth& nozzle, Out& out) {
+    out("nozzle", nozzle.nozzle());
+    out("density", nozzle.density());
+    out("roi_centre_east_m", nozzle.roi_centre_east_m());
+    out("roi_centre_north_m", nozzle.roi_centre_north_m());
+}
+template <class Out>
+void fields(const msg::CameraViewTruth& sample, Out& out) {
+    out("time_ns", sample.time_ns());
+    out("camera", sample.camera());
+    out("frame_number", sample.frame_number());
+    out("delivered", sample.delivered());
+    out("rgb_sha256", sample.rgb_sha256().to_string());
+    out("speed_m_s", sample.speed_m_s());
+    out("boom_height_m", sample.boom_height_m());
+    out("nozzles", sample.nozzles());
+}
 
 
 // One JSON object being written: each field's value is rendered as it comes,
@@ -331,6 +367,8 @@ std::string to_json_text(const msg::SerialLine& sample) { return object_text(sam
 std::string to_json_text(const msg::NozzlePwm& sample) { return object_text(sample); }
 std::string to_json_text(const msg::Vehicle2dTruth& sample) { return object_text(sample); }
 std::string to_json_text(const msg::NozzlesTruth& sample) { return object_text(sample); }
+std::string to_json_text(const msg::VisionReport& sample) { return object_text(sample); }
+std::string to_json_text(const msg::CameraViewTruth& sample) { return object_text(sample); }
 
 std::string cdr_hex_json_text(const std::vector<unsigned char>& bytes) {
     static const char* digits = "0123456789abcdef";

@@ -32,6 +32,11 @@ std::string to_json_text(const msg::SerialLine& sample);
 std::string to_json_text(const msg::NozzlePwm& sample);
 std::string to_json_text(const msg::Vehicle2dTruth& sample);
 std::string to_json_text(const msg::NozzlesTruth& sample);
+// Seed 001's vision: the controller's report per frame and the crop truth under
+// each frame (the frames themselves are not recorded: truth/camera_view names
+// each by its SHA-256, and the run renders them again for the report).
+std::string to_json_text(const msg::VisionReport& sample);
+std::string to_json_text(const msg::CameraViewTruth& sample);
 // A sample of a type the rig does not know, as its CDR bytes in hex.
 std::string cdr_hex_json_text(const std::vector<unsigned char>& bytes);
 const char* to_string(msg::BreakpointEventKind kind);

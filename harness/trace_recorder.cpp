@@ -57,6 +57,11 @@ void TraceRecorder::record_boundary_topics() {
     add_channel<msg::NozzlesTruth>(dds_, topics::kNozzlesTruth);
 }
 
+void TraceRecorder::record_vision_topics() {
+    add_channel<msg::VisionReport>(dds_, topics::kVisionReport);
+    add_channel<msg::CameraViewTruth>(dds_, topics::kCameraViewTruth);
+}
+
 bool TraceRecorder::records(const std::string& topic) const {
     return std::any_of(channels_.begin(), channels_.end(), [&](const Channel& channel) { return channel.topic == topic; });
 }

@@ -47,6 +47,9 @@ public:
     // Seed 001's topics (boundary cases): the AD300's and L4's lines, the PWM
     // duties, the 2-D plant's truth. Drained after the fixed ones, in this order.
     void record_boundary_topics();
+    // Seed 001's vision: the controller's reports and the crop truth per frame
+    // (not the frames: megabytes each, and a pure function of case and seed).
+    void record_vision_topics();
 
 private:
     struct Channel {

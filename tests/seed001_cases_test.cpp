@@ -6,6 +6,7 @@
 // file is refused before anything runs, naming the key.
 #include <gtest/gtest.h>
 
+#include "results_support.h"
 #include "run_support.h"
 #include <sys/wait.h>
 #include <unistd.h>
@@ -28,37 +29,11 @@ fs::path fresh_dir(const std::string& name) {
     return rig::testing::fresh_dir("seed001-cases-" + std::to_string(::getpid()) + "-" + name);
 }
 
-int rig(const std::string& args, const fs::path& log) {
-    const std::string command =
-        "timeout -k 10 600 '" RIG_BINARY_DIR "/bin/rig' " + args + " > '" + log.string() + "' 2>&1";
-    const int status = std::system(command.c_str());
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int rig(const std::string& args, const fs::path& log) { return rig::testing::run_rig(args, log, 600); }
 
-nlohmann::json load_results(const fs::path& out) {
-    std::ifstream in(out / "results.json");
-    if (!in) {
-        ADD_FAILURE() << "no results.json in " << out;
-        return nlohmann::json::object();
-    }
-    return nlohmann::json::parse(in);
-}
-
-const nlohmann::json& find_case(const nlohmann::json& results, const std::string& name) {
-    for (const auto& c : results.at("cases")) {
-        if (c.at("name") == name) return c;
-    }
-    throw std::runtime_error("no case " + name + " in the results");
-}
-
-std::set<std::string> failing_metrics(const nlohmann::json& one_case) {
-    std::set<std::string> metrics;
-    for (const auto& failure : one_case.at("failures")) {
-        const std::string line = failure.get<std::string>();
-        metrics.insert(line.substr(0, line.find(' ')));
-    }
-    return metrics;
-}
+using rig::testing::failing_metrics;
+using rig::testing::find_case;
+using rig::testing::load_results;
 
 TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
     const fs::path out = fresh_dir("verdicts");

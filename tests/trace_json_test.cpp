@@ -178,6 +178,54 @@ TEST(TraceJsonText, EveryTypeIsCanonicalAndKeepsItsValues) {
     parsed = canonical(to_json_text(pwm));
     EXPECT_EQ(parsed.at("duty_pct"), nlohmann::json({37.5, 0.0, 100.0, 1.0 / 3.0}));
 
+    msg::VisionReport report;
+    report.time_ns(200'000'000);
+    report.camera(1);
+    report.frame_number(4294967295u);
+    report.status("dark_frame");
+    report.threshold(-1);
+    report.speed_m_s(1.0 / 3.0);
+    for (int i = 3; i < 6; ++i) {
+        msg::NozzleDensityReport nozzle;
+        nozzle.nozzle(static_cast<std::uint16_t>(i));
+        nozzle.measured(i != 4);
+        nozzle.density(i == 5 ? 5e-324 : 0.5625);
+        nozzle.level(static_cast<std::int16_t>(i == 4 ? -1 : 2));
+        report.nozzles().push_back(nozzle);
+    }
+    parsed = canonical(to_json_text(report));
+    EXPECT_EQ(parsed.at("status"), "dark_frame");
+    EXPECT_EQ(parsed.at("threshold"), -1);
+    EXPECT_EQ(parsed.at("frame_number"), 4294967295u);
+    EXPECT_EQ(parsed.at("speed_m_s").get<double>(), 1.0 / 3.0);
+    EXPECT_EQ(parsed.size(), 8u);
+    ASSERT_EQ(parsed.at("nozzles").size(), 3u);
+    EXPECT_EQ(parsed.at("nozzles")[1].at("measured"), false);
+    EXPECT_EQ(parsed.at("nozzles")[1].at("level"), -1);
+    EXPECT_EQ(parsed.at("nozzles")[2].at("density").get<double>(), 5e-324);
+    EXPECT_EQ(parsed.at("nozzles")[2].size(), 4u);
+
+    msg::CameraViewTruth view;
+    view.time_ns(-7);
+    view.camera(0);
+    view.frame_number(12);
+    view.delivered(true);
+    view.rgb_sha256(std::string(64, 'f'));
+    view.boom_height_m(0.5);
+    msg::NozzleRoiTruth roi;
+    roi.nozzle(2);
+    roi.density(0.1 + 0.2);
+    roi.roi_centre_east_m(-1e21);
+    roi.roi_centre_north_m(1e-7);
+    view.nozzles().push_back(roi);
+    parsed = canonical(to_json_text(view));
+    EXPECT_EQ(parsed.at("rgb_sha256"), std::string(64, 'f'));
+    EXPECT_EQ(parsed.at("delivered"), true);
+    EXPECT_EQ(parsed.size(), 8u);
+    EXPECT_EQ(parsed.at("nozzles")[0].at("density").get<double>(), 0.1 + 0.2);
+    EXPECT_EQ(parsed.at("nozzles")[0].at("roi_centre_east_m").get<double>(), -1e21);
+    EXPECT_EQ(parsed.at("nozzles")[0].size(), 4u);
+
     EXPECT_EQ(to_json_text(msg::SectionValves{}), R"({"open_mask":0})");
     EXPECT_EQ(to_json_text(msg::UnloadingValve{}), R"({"open":false})");
     EXPECT_EQ(to_json_text(msg::SwitchLevel{}), R"({"closed":false})");

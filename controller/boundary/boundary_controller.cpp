@@ -132,6 +132,24 @@ TimeNs BoundaryController::update(TimeNs now_ns) {
     return deadline;
 }
 
+void BoundaryController::enable_vision(int blind_level) {
+    if (blind_level < 0 || blind_level > 2) {
+        throw std::invalid_argument("vision.blind_level: must be 0, 1 or 2, got " + std::to_string(blind_level));
+    }
+    vision_ = true;
+    vision_blind_level_ = blind_level;
+    vision_density_.assign(static_cast<std::size_t>(config_.nozzle_count), std::nullopt);
+}
+
+void BoundaryController::set_vision_density(int nozzle, std::optional<double> density) {
+    if (!vision_) throw std::logic_error("set_vision_density before enable_vision");
+    if (nozzle < 0 || nozzle >= config_.nozzle_count) {
+        throw std::invalid_argument("vision density for nozzle " + std::to_string(nozzle) + ": the boom has " +
+                                    std::to_string(config_.nozzle_count));
+    }
+    vision_density_[static_cast<std::size_t>(nozzle)] = density;
+}
+
 void BoundaryController::decide() {
     if (!status_.have_fix || !status_.course_deg) {
         all_off();
@@ -184,8 +202,13 @@ void BoundaryController::decide() {
         // Sec. 4.2: a nozzle sprays only while it and the boom centre are both inside.
         const bool centre_allows = status_.centre_inside || faults.ignore_centre_rule;
         if (centre_allows && nozzle.inside && nozzle.area >= 0) {
-            const double density = areas_[static_cast<std::size_t>(nozzle.area)].density();
-            nozzle.level = spray_level(config_, eq14_theoretical_duty_pct(config_, density, v));
+            if (vision_) {
+                const std::optional<double>& seen = vision_density_[idx];
+                nozzle.level = seen ? spray_level(config_, eq14_theoretical_duty_pct(config_, *seen, v)) : vision_blind_level_;
+            } else {
+                const double density = areas_[static_cast<std::size_t>(nozzle.area)].density();
+                nozzle.level = spray_level(config_, eq14_theoretical_duty_pct(config_, density, v));
+            }
         }
         nozzle.duty_pct = level_duty_pct(config_, nozzle.level);
         duty_pct_[idx] = nozzle.duty_pct;

@@ -72,6 +72,14 @@ public:
     // when nothing is pending).
     TimeNs update(TimeNs now_ns);
 
+    // The vision half (Sec. 2, 4.1): from now on each nozzle's level comes
+    // from the density set for it (Eq. 17 of its ROI), not its area's; a
+    // nozzle without one (nullopt) sprays at blind_level (0, 1, 2).
+    void enable_vision(int blind_level);
+    void set_vision_density(int nozzle, std::optional<double> density);
+    // Decide again with the last fix (a frame changed a density).
+    void redecide() { decide(); }
+
     // Outputs: duty per nozzle, %, and the PWM frequency.
     const std::vector<double>& duty_pct() const { return duty_pct_; }
     double pwm_frequency_hz() const { return config_.pwm_frequency_hz; }
@@ -95,6 +103,9 @@ private:
     BoundaryStatus status_;
     std::vector<double> duty_pct_;
     std::vector<bool> nozzle_was_inside_;
+    bool vision_ = false;
+    int vision_blind_level_ = 2;
+    std::vector<std::optional<double>> vision_density_;
     bool centre_was_inside_ = false;
     std::vector<std::string> notices_;
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <optional>
 
 #include "idl/topics.h"
 
@@ -12,7 +13,17 @@ BoundaryControllerNode::BoundaryControllerNode(std::string node_name, BoundaryNo
     : name_(std::move(node_name)),
       serial_(std::move(serial)),
       sweep_(std::move(config.calibration)),
-      logic_(std::move(config.controller)) {}
+      logic_(config.controller),
+      vision_config_(config.vision) {
+    if (vision_config_.enabled) {
+        std::size_t index = 0;
+        for (vision::VisionCameraConfig& camera : vision::seed001_vision_cameras(config.controller)) {
+            cameras_.emplace_back(std::move(camera), vision_config_.params, index++);
+        }
+        logic_.enable_vision(vision_config_.blind_level);
+        density_time_ns_.assign(static_cast<std::size_t>(config.controller.nozzle_count), -1);
+    }
+}
 
 void BoundaryControllerNode::configure(DdsContext& dds) {
     // A wired input is a port, not a subscription: the node then never reads that topic.
@@ -27,10 +38,84 @@ void BoundaryControllerNode::configure(DdsContext& dds) {
         laser_port_ = std::make_unique<SerialPort>(serial_.laser_port, serial_.laser_line);
     }
     pwm_writer_ = std::make_unique<Writer<msg::NozzlePwm>>(dds, topics::kNozzlePwm);
+    if (vision_config_.enabled) {
+        if (cameras_.size() != 2) throw std::runtime_error("vision: expected the two cameras of Sec. 1.1");
+        frame_readers_.push_back(std::make_unique<Reader<msg::CameraFrame>>(dds, topics::kCameraLeftFrame));
+        frame_readers_.push_back(std::make_unique<Reader<msg::CameraFrame>>(dds, topics::kCameraRightFrame));
+        vision_writer_ = std::make_unique<Writer<msg::VisionReport>>(dds, topics::kVisionReport);
+    }
 }
 
 bool BoundaryControllerNode::has_unread_input() const {
-    return (nmea_reader_ && nmea_reader_->has_unread()) || (laser_reader_ && laser_reader_->has_unread());
+    if ((nmea_reader_ && nmea_reader_->has_unread()) || (laser_reader_ && laser_reader_->has_unread())) return true;
+    for (const auto& reader : frame_readers_) {
+        if (reader->has_unread()) return true;
+    }
+    return false;
+}
+
+void BoundaryControllerNode::process_frame(std::size_t camera, const msg::CameraFrame* frame, TimeNs now_ns) {
+    const BoundaryStatus& status = logic_.status();
+    std::optional<rig::camera::RgbImage> image;
+    if (frame != nullptr) {
+        image.emplace();
+        image->width = frame->width_px();
+        image->height = frame->height_px();
+        image->bytes = frame->rgb();
+        // A frame whose pixels do not fill its size is a broken frame: measured as the wrong size.
+        if (image->bytes.size() != static_cast<std::size_t>(image->width) * static_cast<std::size_t>(image->height) * 3U) {
+            image->width = 0;
+            image->height = 0;
+            image->bytes.clear();
+        }
+    }
+    const vision::FrameDensities densities =
+        cameras_[camera].measure(image ? &*image : nullptr, status.boom_height_m);
+    msg::VisionReport report;
+    report.time_ns(now_ns);
+    report.camera(static_cast<std::uint16_t>(camera));
+    report.frame_number(frame != nullptr ? frame->frame_number() : 0);
+    report.status(vision::frame_status_name(densities.status));
+    report.threshold(static_cast<std::int16_t>(densities.status == vision::FrameStatus::ok ? densities.threshold : -1));
+    report.speed_m_s(status.speed_m_s);
+    report.boom_height_m(status.boom_height_m);
+    const BoundaryControllerConfig& config = logic_.config();
+    for (const int nozzle : cameras_[camera].camera().nozzles) {
+        msg::NozzleDensityReport entry;
+        entry.nozzle(static_cast<std::uint16_t>(nozzle));
+        entry.measured(false);
+        entry.density(0.0);
+        entry.level(-1);
+        for (const vision::NozzleDensity& measured : densities.nozzles) {
+            if (measured.nozzle != nozzle || !measured.measured) continue;
+            entry.measured(true);
+            entry.density(measured.density);
+            entry.level(static_cast<std::int16_t>(vision::vision_spray_level(config, measured, status.speed_m_s).value_or(-1)));
+        }
+        // A frame without a density for this nozzle leaves it blind now, not at its old density.
+        logic_.set_vision_density(nozzle, entry.measured() ? std::optional<double>(entry.density()) : std::nullopt);
+        density_time_ns_[static_cast<std::size_t>(nozzle)] = entry.measured() ? now_ns : -1;
+        report.nozzles().push_back(entry);
+    }
+    vision_writer_->publish(report);
+}
+
+TimeNs BoundaryControllerNode::expire_densities(TimeNs now_ns) {
+    const TimeNs max_age = seconds_to_ns(vision_config_.density_max_age_s);
+    TimeNs next = kNever;
+    bool expired = false;
+    for (std::size_t n = 0; n < density_time_ns_.size(); ++n) {
+        if (density_time_ns_[n] < 0) continue;
+        if (now_ns >= density_time_ns_[n] + max_age) {
+            logic_.set_vision_density(static_cast<int>(n), std::nullopt);
+            density_time_ns_[n] = -1;
+            expired = true;
+        } else {
+            next = std::min(next, density_time_ns_[n] + max_age);
+        }
+    }
+    if (expired) logic_.redecide();
+    return next;
 }
 
 std::vector<std::string> BoundaryControllerNode::take_lines(SerialPort& port) {
@@ -72,7 +157,17 @@ TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
     } else {
         for (const std::string& line : take_lines(*nmea_port_)) logic_.on_nmea_sentence(line, now_ns);
     }
+    // Frames after the fix and the height they are measured at: left, then right.
+    bool frames = false;
+    for (std::size_t camera = 0; camera < frame_readers_.size(); ++camera) {
+        for (const msg::CameraFrame& frame : frame_readers_[camera]->take_all()) {
+            process_frame(camera, &frame, now_ns);
+            frames = true;
+        }
+    }
+    if (frames) logic_.redecide();
     TimeNs next_wake = logic_.update(now_ns);
+    if (vision_config_.enabled) next_wake = std::min(next_wake, expire_densities(now_ns));
     std::vector<double> duty = logic_.duty_pct();
     if (!sweep_.duties_pct.empty()) {
         TimeNs next_change = kNever;

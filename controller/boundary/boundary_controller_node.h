@@ -5,8 +5,11 @@
 // (boundary_controller.h), and publishes the PWM duty of every nozzle when it
 // changes. It never sees truth.
 //
-// Subscriptions: device/gnss/nmea, device/laser_height/serial
-// Publications:  actuator/nozzle_pwm/duty
+// Subscriptions: device/gnss/nmea, device/laser_height/serial; with
+//                vision (boundary_node_config.h) device/camera_left/frame and
+//                device/camera_right/frame
+// Publications:  actuator/nozzle_pwm/duty; with vision controller/vision/density
+//                (one VisionReport per frame processed)
 // Wired (the bench path, real time only): the RMC and laser lines come from
 // serial ports instead of those two topics, as the Pi's UARTs have them; the
 // PWM duty still goes out on DDS.
@@ -18,6 +21,7 @@
 
 #include "controller/boundary/boundary_controller.h"
 #include "controller/boundary/boundary_node_config.h"
+#include "controller/boundary/vision/nozzle_vision.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
 #include "rig/wire/serial_port.h"
@@ -44,6 +48,13 @@ public:
     bool has_unread_input() const override;
 
 private:
+    // Eq. 15-17 on a camera's frame (nullptr: none), the densities into the
+    // logic, and its report. Returns whether any density changed.
+    void process_frame(std::size_t camera, const msg::CameraFrame* frame, TimeNs now_ns);
+    // Densities older than vision.density_max_age_s are dropped (the camera
+    // stopped); returns when the next one expires.
+    TimeNs expire_densities(TimeNs now_ns);
+
     // The sweep's duty at now_ns and when it next changes.
     double sweep_duty_pct(TimeNs now_ns, TimeNs& next_change_ns) const;
 
@@ -59,6 +70,11 @@ private:
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
     std::unique_ptr<Reader<msg::SerialLine>> laser_reader_;
     std::unique_ptr<Writer<msg::NozzlePwm>> pwm_writer_;
+    VisionNodeConfig vision_config_;
+    std::vector<vision::CameraVision> cameras_;
+    std::vector<std::unique_ptr<Reader<msg::CameraFrame>>> frame_readers_;
+    std::unique_ptr<Writer<msg::VisionReport>> vision_writer_;
+    std::vector<TimeNs> density_time_ns_;  // per nozzle, when its density was measured (-1: none)
     std::vector<double> published_duty_pct_;
     bool published_once_ = false;
 };

@@ -63,6 +63,24 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
     c.faults.ignore_centre_rule = faults.optional<bool>("ignore_centre_rule", false);
 
+    const YamlSection vision = section.section("vision");
+    VisionNodeConfig& v = node.vision;
+    v.enabled = vision.optional<bool>("enabled", v.enabled);
+    read_double(vision, "roi_width_m", v.params.roi_width_m);
+    read_double(vision, "roi_near_m", v.params.roi_near_m);
+    read_double(vision, "roi_depth_m", v.params.roi_depth_m);
+    read_double(vision, "warp_mm_per_px", v.params.warp_mm_per_px);
+    v.params.exg_floor = vision.optional_in_range<int>("exg_floor", v.params.exg_floor, Bounds::closed(0, 255));
+    read_double(vision, "dark_frame_mean_max_dn", v.params.dark_frame_mean_max_dn);
+    read_double(vision, "min_roi_share_in_frame", v.params.min_roi_share_in_frame);
+    v.blind_level = vision.optional_in_range<int>("blind_level", v.blind_level, Bounds::closed(0, 2));
+    v.density_max_age_s = vision.optional_in_range<double>("density_max_age_s", v.density_max_age_s, Bounds::open_closed(0, 60));
+    try {
+        vision::validate(v.params);
+    } catch (const std::invalid_argument& error) {
+        vision.fail(error.what());
+    }
+
     const YamlSection sweep = section.section("calibration");
     const std::vector<std::string> duties = sweep.string_list("duties_pct");
     for (std::size_t i = 0; i < duties.size(); ++i) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "controller/boundary/boundary_config.h"
+#include "controller/boundary/vision/vision_params.h"
 #include "rig/config/yaml_fields.h"
 
 namespace rig::controller::boundary {
@@ -24,9 +25,27 @@ struct DutySweepConfig {
     double hold_s = 10.0;            // (0, 3600]; the paper: 60 s per point
 };
 
+// The vision half (Sec. 2, 4.1): with `vision: { enabled: true }` each
+// nozzle's level comes from the density its camera measures in every frame
+// (device/camera_left|right/frame), instead of its area's `density`. The two
+// cameras are Sec. 1.1's at their design calibration
+// (vision::seed001_vision_cameras): left sees the first half of the nozzles.
+struct VisionNodeConfig {
+    bool enabled = false;
+    vision::VisionParams params;
+    // The level of a nozzle whose camera gives no density (no frame, a dark
+    // frame, its ROI out of the frame). Assumed 2: spray as a sprayer without
+    // vision would; a missed weed patch costs more than the chemical. [0, 2]
+    int blind_level = 2;
+    // A density older than this (no newer frame) is no density: the camera
+    // has stopped. Assumed 1 s, five frames at the cases' 5 fps. (0, 60] s
+    double density_max_age_s = 1.0;
+};
+
 struct BoundaryNodeConfig {
     BoundaryControllerConfig controller;
     DutySweepConfig calibration;
+    VisionNodeConfig vision;
 };
 
 // Throws rig::ConfigError at the offending key (a bound BoundaryControllerConfig's

@@ -35,6 +35,7 @@
 #include <Eigen/Dense>
 
 #include "controller/boundary/boundary_config.h"
+#include "controller/boundary/vision/vision_params.h"
 #include "rig/camera/pinhole_camera.h"
 #include "rig/camera/rgb_image.h"
 
@@ -57,30 +58,8 @@ struct VisionCameraConfig {
     std::vector<PixelPoint> nozzle_pixels;
 };
 
-struct VisionParams {
-    // Sec. 2.1: the ROI is w = 600 mm across, from h1 = 200 mm to h1 + h2 =
-    // 600 mm ahead of the nozzle (Sec. 5.2 marks the same 60 x 40 cm frames).
-    double roi_width_m = 0.600;              // (0, 5] m
-    double roi_near_m = 0.200;               // [-2, 5] m
-    double roi_depth_m = 0.400;              // (0, 5] m
-    // The warped rectangle's pixel size on the ground. Assumed 2 mm: about the
-    // ground footprint of a pixel across the ROI at 1280 x 720 (1.7-2.5 mm),
-    // so the warp neither throws away nor invents detail. The paper gives none.
-    double warp_mm_per_px = 2.0;             // [0.5, 50] mm
-    // S7: the least ExG counted as plant whatever Otsu finds. Assumed 40: bare
-    // soil's ExG is about 0 with a noise SD near 15 DN at 6 DN per channel, a
-    // seedling leaf's about 150.
-    int exg_floor = 40;                      // [0, 255]
-    // A frame whose mean byte is at most this is dark (a dead or covered
-    // camera): no density, not D = 0. Assumed 8 DN (soil in shade is ~40).
-    double dark_frame_mean_max_dn = 8.0;     // [0, 255]
-    // A nozzle gets a density only when this share of its warped ROI lies
-    // inside the frame (assumed).
-    double min_roi_share_in_frame = 0.95;    // (0, 1]
-};
 
-// Throws std::invalid_argument "vision.<field>: <what>" / "vision.cameras[i] '<name>'.<field>: ...".
-void validate(const VisionParams& params);
+// Throws std::invalid_argument "vision.cameras[i] '<name>'.<field>: ...".
 void validate(const VisionCameraConfig& camera, std::size_t index);
 
 // Sec. 1.1's two cameras (left sees the first half of the nozzles, right the
