@@ -37,6 +37,9 @@ RIG_DECLARE_MSG(SerialLine)
 RIG_DECLARE_MSG(NozzlePwm)
 RIG_DECLARE_MSG(Vehicle2dTruth)
 RIG_DECLARE_MSG(NozzlesTruth)
+RIG_DECLARE_MSG(CameraFrame)
+RIG_DECLARE_MSG(VisionReport)
+RIG_DECLARE_MSG(CameraViewTruth)
 
 #undef RIG_DECLARE_MSG
 

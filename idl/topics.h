@@ -26,6 +26,9 @@ inline constexpr const char* kBreakpointButton = "device/breakpoint_button/level
 inline constexpr const char* kSpraySwitch = "device/spray_switch/level";             // msg::SwitchLevel
 // Seed 001: the L4 laser boom-height sensor's serial lines (the AD300's RMC uses kGnssNmea).
 inline constexpr const char* kLaserHeightSerial = "device/laser_height/serial";     // msg::SerialLine
+// Seed 001: the two boom cameras' frames (Sec. 1.1; left sees nozzles 0-2, right 3-5).
+inline constexpr const char* kCameraLeftFrame = "device/camera_left/frame";         // msg::CameraFrame
+inline constexpr const char* kCameraRightFrame = "device/camera_right/frame";       // msg::CameraFrame
 
 // Actuator topics (controller -> plant)
 inline constexpr const char* kBallValveRelays = "actuator/ball_valve/relays";      // msg::BallValveRelays
@@ -37,6 +40,8 @@ inline constexpr const char* kNozzlePwm = "actuator/nozzle_pwm/duty";           
 // Controller outputs
 inline constexpr const char* kControllerStatus = "controller/status";          // msg::ControllerStatus
 inline constexpr const char* kBreakpointEvent = "controller/breakpoint_event"; // msg::BreakpointEvent
+// Seed 001: the density and level the controller's vision found in each frame.
+inline constexpr const char* kVisionReport = "controller/vision/density";      // msg::VisionReport
 
 // Truth (plant -> harness, emulators)
 inline constexpr const char* kVehicleTruth = "truth/vehicle";        // msg::VehicleTruth
@@ -44,5 +49,7 @@ inline constexpr const char* kHydraulicsTruth = "truth/hydraulics";  // msg::Hyd
 // Seed 001's 2-D plant.
 inline constexpr const char* kVehicle2dTruth = "truth/vehicle2d";    // msg::Vehicle2dTruth
 inline constexpr const char* kNozzlesTruth = "truth/nozzles";        // msg::NozzlesTruth
+// Seed 001's crop truth under each camera frame's ROIs.
+inline constexpr const char* kCameraViewTruth = "truth/camera_view";  // msg::CameraViewTruth
 
 }  // namespace rig::topics

@@ -77,8 +77,9 @@ TEST(BoundaryIdl, NewTopicNamesAreUnique) {
                                       t::kBoomHeightSensor, t::kBreakpointButton, t::kSpraySwitch,    t::kLaserHeightSerial,
                                       t::kBallValveRelays, t::kSectionValves,    t::kUnloadingValve, t::kNozzlePwm,
                                       t::kControllerStatus, t::kBreakpointEvent, t::kVehicleTruth,   t::kHydraulicsTruth,
-                                      t::kVehicle2dTruth,  t::kNozzlesTruth};
-    EXPECT_EQ(names.size(), 22u);
+                                      t::kVehicle2dTruth,  t::kNozzlesTruth,     t::kCameraLeftFrame, t::kCameraRightFrame,
+                                      t::kVisionReport,    t::kCameraViewTruth};
+    EXPECT_EQ(names.size(), 26u);
 }
 
 }  // namespace
