@@ -5,6 +5,8 @@
 //   build/bin/vision_bench                     ms per frame: rendered (emulator), measured (controller)
 //   build/bin/vision_bench --density-survey    measured - true D per ROI, per cover class and fault
 //   build/bin/vision_bench --frames DIR        PNGs of the left camera's frames with the ROIs drawn
+//   build/bin/vision_bench --benchmark_filter=OverDds   ms per frame delivered over DDS (scripts/netns-run
+//                                              around it keeps it in a loopback-only namespace)
 //
 // Frames: 1280 x 720, 2 x 2 samples per pixel, the default fields; each
 // benchmark iteration renders the next frame of a boom driving north at
@@ -17,6 +19,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,6 +28,12 @@
 #include "emulators/field2d/crop_cover_map.h"
 #include "emulators/vision/camera_emulator.h"
 #include "rig/camera/png_file.h"
+#include "rig/host/child_process.h"
+#include "rig/host/domain_lease.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+#include "camera_frame_pattern.h"
+#include "idl/topics.h"
 
 namespace {
 
@@ -73,9 +83,98 @@ void BM_MeasureFrame(benchmark::State& state) {
     }
 }
 
+// A process's resident set now and at its peak (kB), from /proc/PID/status.
+std::pair<double, double> rss_kb(const std::string& pid = "self") {
+    std::ifstream status("/proc/" + pid + "/status");
+    std::string key;
+    double rss = 0.0;
+    double peak = 0.0;
+    while (status >> key) {
+        if (key == "VmRSS:") status >> rss;
+        else if (key == "VmHWM:") status >> peak;
+        status.ignore(1 << 16, '\n');
+    }
+    return {rss, peak};
+}
+
+template <class Ready>
+void wait_matched(Ready ready) {
+    const rig::WallStopwatch waited;
+    while (!ready()) {
+        if (waited.elapsed() > std::chrono::milliseconds(60'000)) throw std::runtime_error("DDS endpoints never matched");
+        rig::pause_between_polls(std::chrono::milliseconds(5));
+    }
+}
+
+// The timed loop both DDS benchmarks share: a frame (its pixels made once,
+// outside the loop) published and acknowledged by every matched reader, then
+// `taken` (the answer that it was taken) awaited; the resident set after.
+template <class Taken>
+void deliver_frames(benchmark::State& state, rig::Writer<rig::msg::CameraFrame>& writer, Taken taken) {
+    rig::msg::CameraFrame frame = rig::testing::patterned_frame(0, 1280, 720);
+    std::uint32_t number = 0;
+    for (auto _ : state) {
+        frame.frame_number(number++);
+        writer.publish(frame);
+        if (!writer.wait_delivered(std::chrono::milliseconds(60'000))) state.SkipWithError("frame not acknowledged");
+        if (!taken()) state.SkipWithError("frame not taken");
+    }
+    state.counters["rss_MB"] = rss_kb().first / 1024.0;
+    state.counters["peak_rss_MB"] = rss_kb().second / 1024.0;
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * 1280 * 720 * 3);
+}
+
+// One 1280 x 720 frame from the camera's participant to the controller's, both
+// in this process (Fast DDS delivers in process, no transport): publish, wait
+// until the reader has acknowledged it (it is in the reader's history, as
+// lockstep waits), take it.
+void BM_DeliverFrameOverDds(benchmark::State& state) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext camera(lease.domain_id(), "camera");
+    rig::DdsContext controller(lease.domain_id(), "controller");
+    const double rss_before_kb = rss_kb().first;
+    rig::Writer<rig::msg::CameraFrame> writer(camera, rig::topics::kCameraLeftFrame);
+    rig::Reader<rig::msg::CameraFrame> reader(controller, rig::topics::kCameraLeftFrame);
+    state.counters["endpoints_MB"] = (rss_kb().first - rss_before_kb) / 1024.0;
+    wait_matched([&] { return writer.matched_readers() >= 1 && reader.matched_writers() >= 1; });
+    deliver_frames(state, writer, [&] {
+        std::size_t frames = 0;
+        while (frames == 0 && reader.wait_for_data(std::chrono::milliseconds(60'000))) frames = reader.take_all().size();
+        return frames == 1;
+    });
+}
+
+// The same frame to a reader in another process (tests/camera_frame_node.cpp
+// --sink): through the transports as RTPS fragments. Publish, wait until that
+// reader has acknowledged it, then until the sink says it took it (a small
+// sample back): without that answer this writer would outrun the sink's take
+// loop and the frames pile up in its keep-all history.
+void BM_DeliverFrameOverDdsAcrossProcesses(benchmark::State& state) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext camera(lease.domain_id(), "camera");
+    const double rss_before_kb = rss_kb().first;
+    rig::Writer<rig::msg::CameraFrame> writer(camera, rig::topics::kCameraLeftFrame);
+    state.counters["endpoints_MB"] = (rss_kb().first - rss_before_kb) / 1024.0;
+    rig::Reader<rig::msg::NmeaSentence> taken(camera, "test/frame_taken");
+    rig::ChildProcess sink({RIG_CAMERA_FRAME_NODE, "--domain", std::to_string(lease.domain_id()), "--sink"},
+                           "/dev/null");
+    wait_matched([&] { return writer.matched_readers() >= 1 && taken.matched_writers() >= 1; });
+    deliver_frames(state, writer, [&] {
+        std::size_t answers = 0;
+        while (answers == 0 && taken.wait_for_data(std::chrono::milliseconds(60'000))) answers = taken.take_all().size();
+        return answers == 1;
+    });
+    state.counters["sink_peak_rss_MB"] = rss_kb(std::to_string(sink.pid())).second / 1024.0;
+    writer.publish(rig::testing::patterned_frame(0xffffffffu, 0, 0));  // the sink's stop
+    writer.wait_delivered(std::chrono::milliseconds(60'000));
+    sink.stop(std::chrono::milliseconds(10'000));
+}
+
 BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK(BM_RenderFrameDirtyLens)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK(BM_MeasureFrame)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+BENCHMARK(BM_DeliverFrameOverDds)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
+BENCHMARK(BM_DeliverFrameOverDdsAcrossProcesses)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
 
 struct SurveyCase {
     const char* name;

@@ -37,6 +37,35 @@ dds::DataWriterQos project_writer_qos(dds::Publisher& publisher) {
     return qos;
 }
 
+// A type whose bounded serialized size exceeds this (seed 001's CameraFrame:
+// 11 MB for up to 2560 x 1440 RGB) gets large-type history memory below. Every
+// other type of the project stays far under it (the raw diagnostic type is
+// exactly 64 KiB) and keeps Fast DDS's defaults, so nothing about small types changes.
+constexpr std::uint32_t kLargeTypeBytes = 64 * 1024;
+
+// The bounded serialized size of a topic's type (encapsulation included).
+std::uint32_t max_serialized_size(dds::DomainParticipant& participant, const dds::Topic& topic) {
+    const dds::TypeSupport type = participant.find_type(topic.get_type_name());
+    return type.empty() ? 0 : type->m_typeSize;
+}
+
+// Fast DDS's default history memory (PREALLOCATED_WITH_REALLOC) reserves
+// `allocated_samples` payloads (100 by default) of the type's bound up front,
+// for the writer and again for each reader. With an 11 MB bound that is 1.1 GB
+// an endpoint: a writer and a reader in one process were 2.1 GB resident as
+// soon as frames flowed (vision_bench BM_DeliverFrameOverDds,
+// docs/seed001-vision.md). One slot up front, more made as frames are in flight
+// at once, keeps the payloads at the frames really held (72 MB peak for that
+// pair) at the same cost per frame. DYNAMIC_REUSABLE_MEMORY_MODE was measured
+// too: 32 MB, but 2.2 ms of CPU a frame instead of 0.16 ms in process (each
+// payload allocated and faulted in anew), so the preallocating policy stays.
+// Reliability, keep-all, max_samples and thus the lockstep guarantee (a tick is
+// acknowledged once every sample is in every reader's history) are untouched.
+template <class Qos>
+void apply_large_type_memory(Qos& qos) {
+    qos.resource_limits().allocated_samples = 1;
+}
+
 dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber) {
     dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
@@ -68,8 +97,12 @@ void delete_writer(dds::Publisher& publisher, dds::DataWriter* writer) {
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
     : context_(&context), topic_name_(std::move(topic_name)), counts_as_output_(counts_as_output) {
-    writer_ = context_->publisher().create_datawriter(topic, project_writer_qos(context_->publisher()), &listener_,
-                                                      dds::StatusMask::publication_matched());
+    dds::DataWriterQos qos = project_writer_qos(context_->publisher());
+    if (const std::uint32_t bound = max_serialized_size(context_->participant(), *topic); bound > kLargeTypeBytes) {
+        apply_large_type_memory(qos);
+        max_serialized_bytes_ = bound;
+    }
+    writer_ = context_->publisher().create_datawriter(topic, qos, &listener_, dds::StatusMask::publication_matched());
     if (writer_ == nullptr) throw std::runtime_error("cannot create DDS writer on topic " + topic_name_);
     context_->register_writer(this);
 }
@@ -88,6 +121,19 @@ void WriterBase::detach() {
 
 bool WriterBase::write_raw(void* sample) {
     if (writer_ == nullptr) return false;
+    if (max_serialized_bytes_ != 0) {
+        // A frame past its type's bound would only fail inside Fast DDS as "write
+        // failed" (the serializer runs out of the bound-sized payload); say which
+        // bound, before anything is written. Large types only: the size costs
+        // a call per write, and small types keep exactly their old path.
+        const std::uint32_t size = writer_->get_type()->getSerializedSizeProvider(sample)();
+        if (size > max_serialized_bytes_) {
+            throw std::runtime_error("DDS write refused on topic " + topic_name_ + ": the sample serializes to " +
+                                     std::to_string(size) + " bytes, past its type's bound of " +
+                                     std::to_string(max_serialized_bytes_) + " bytes (" +
+                                     writer_->get_type().get_type_name() + ")");
+        }
+    }
     undelivered_.store(true);
     if (!writer_->write(sample)) return false;
     written_.fetch_add(1);
@@ -108,9 +154,10 @@ void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.no
 
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
     : context_(&context), topic_name_(std::move(topic_name)), listener_(context) {
+    dds::DataReaderQos qos = project_reader_qos(context_->subscriber());
+    if (max_serialized_size(context_->participant(), *topic) > kLargeTypeBytes) apply_large_type_memory(qos);
     reader_ = context_->subscriber().create_datareader(
-        topic, project_reader_qos(context_->subscriber()), &listener_,
-        dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
+        topic, qos, &listener_, dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
     if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
     context_->register_reader(this);
 }

@@ -83,6 +83,9 @@ private:
     MatchListener listener_;
     dds::DataWriter* writer_ = nullptr;
     bool counts_as_output_;
+    // A large type's bound in serialized bytes, checked before each write so a
+    // refusal names it (0: a small type, written exactly as before).
+    std::uint32_t max_serialized_bytes_ = 0;
     std::atomic<bool> undelivered_{false};
     std::atomic<std::uint64_t> written_{0};
 };
@@ -93,6 +96,8 @@ template <class Msg>
 class Writer final : public WriterBase {
 public:
     Writer(DdsContext& context, const std::string& topic_name, bool counts_as_output = true);
+    // Throws std::runtime_error when the sample is not written (a large type's
+    // sample past its bound says so by name).
     void publish(const Msg& sample) {
         if (!write_raw(const_cast<Msg*>(&sample))) {
             throw std::runtime_error("DDS write failed on topic " + topic_name());
