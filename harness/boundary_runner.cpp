@@ -138,6 +138,8 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                 cameras.push_back(std::make_unique<CameraNode>(world.kinematics, *world.crop,
                                                                camera == 0 ? world.vision->left : world.vision->right,
                                                                seed, camera, nozzles, right_m));
+                // The report shows each camera's frame from the middle of the run.
+                cameras.back()->keep_frame_at(world.end_ns / 2);
                 nodes.push_back(cameras.back().get());
             }
         }
@@ -211,7 +213,15 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                                                         {"startup_wall_seconds", startup_wall_s}};
         run_facts["in_process_refused"] = asked_in_process ? "seed 001's boundary controller has no plugin" : "";
         run_facts["plant_rejected_duty_commands"] = plant.rejected_commands();
-        for (const auto& camera : cameras) run_facts[camera->name() + "_frames"] = camera->frames_rendered();
+        nlohmann::json report_frames = nlohmann::json::array();
+        for (std::size_t c = 0; c < cameras.size(); ++c) {
+            run_facts[cameras[c]->name() + "_frames"] = cameras[c]->frames_rendered();
+            const std::string file = "frame-" + cameras[c]->name() + ".png";
+            if (const std::optional<std::uint64_t> number = cameras[c]->write_report_frame(case_dir / file)) {
+                report_frames.push_back({{"camera", c}, {"frame_number", *number}, {"file", file}});
+            }
+        }
+        if (!cameras.empty()) trace.file().set_meta("vision_report_frames", report_frames.dump());
         if (pwm_capture) run_facts["nozzle_pwm_captured"] = pwm_capture->published();
         trace.file().set_meta("run", run_facts.dump());
         trace.file().finish(outcome);

@@ -7,6 +7,7 @@
 #include <openssl/evp.h>
 
 #include "idl/topics.h"
+#include "rig/camera/png_file.h"
 
 namespace rig::harness {
 
@@ -227,6 +228,11 @@ TimeNs CameraNode::step(TimeNs now_ns) {
             nozzle.roi_centre_north_m((roi[0].north_m + roi[1].north_m + roi[2].north_m + roi[3].north_m) / 4.0);
             view.nozzles().push_back(nozzle);
         }
+        if (image && keep_at_ns_ && !kept_frame_ && t_ns >= *keep_at_ns_) {
+            kept_frame_ = *image;
+            kept_frame_number_ = frame_count_;
+            kept_boom_height_m_ = truth.boom_height_m;
+        }
         if (image) {
             view.rgb_sha256(sha256_hex(image->bytes));
             msg::CameraFrame frame;
@@ -240,6 +246,29 @@ TimeNs CameraNode::step(TimeNs now_ns) {
         ++frame_count_;
     }
     return frame_time_ns(frame_count_);
+}
+
+std::optional<std::uint64_t> CameraNode::write_report_frame(const std::filesystem::path& file) const {
+    if (!kept_frame_) return std::nullopt;
+    rig::camera::RgbImage frame = *kept_frame_;
+    // Sec. 2.1's ROI of each nozzle in the boom frame (x right, y ahead, the
+    // ground at z = -h), as field2d::nozzle_roi_ground lays it on the field.
+    const double h = kept_boom_height_m_;
+    const rig::camera::Rgb yellow{255, 230, 0};
+    for (const double right_m : nozzle_right_m_) {
+        std::array<Eigen::Vector2d, 4> corners;
+        const double xs[4] = {right_m - 0.3, right_m + 0.3, right_m + 0.3, right_m - 0.3};
+        const double ys[4] = {0.2, 0.2, 0.6, 0.6};
+        bool seen = true;
+        for (int i = 0; i < 4; ++i) {
+            const std::optional<Eigen::Vector2d> px = emulator_.true_camera().project(Eigen::Vector3d(xs[i], ys[i], -h));
+            if (!px) seen = false;
+            corners[static_cast<std::size_t>(i)] = px.value_or(Eigen::Vector2d::Zero());
+        }
+        if (seen) rig::camera::draw_quad(frame, corners, yellow, 2);
+    }
+    rig::camera::write_png(file.string(), frame);
+    return kept_frame_number_;
 }
 
 }  // namespace rig::harness

@@ -13,6 +13,7 @@
 //                      its nozzles' ROIs on truth/camera_view.
 // A pure function of the case and the seed: same seed, same trace.
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -126,6 +127,14 @@ public:
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
     std::uint64_t frames_rendered() const { return frame_count_; }
+    // Keeps a copy of the first frame exposed at or after `at_ns`, for the
+    // report: the frame with the ROIs drawn (write_report_frame).
+    void keep_frame_at(TimeNs at_ns) { keep_at_ns_ = at_ns; }
+    // Writes the kept frame as a PNG with each nozzle's true Sec. 2.1 ROI
+    // outlined (projected through the camera as it truly is, faults included);
+    // returns its frame number, or nullopt when no frame was kept (a dead
+    // camera). Throws std::runtime_error naming the file when it cannot be written.
+    std::optional<std::uint64_t> write_report_frame(const std::filesystem::path& file) const;
 
 private:
     TimeNs frame_time_ns(std::uint64_t k) const;
@@ -139,6 +148,10 @@ private:
     std::vector<double> nozzle_right_m_;
     double frame_rate_hz_;
     std::uint64_t frame_count_ = 0;
+    std::optional<TimeNs> keep_at_ns_;
+    std::optional<rig::camera::RgbImage> kept_frame_;
+    std::uint64_t kept_frame_number_ = 0;
+    double kept_boom_height_m_ = 0.0;
     std::unique_ptr<Writer<msg::CameraFrame>> frame_writer_;
     std::unique_ptr<Writer<msg::CameraViewTruth>> truth_writer_;
 };

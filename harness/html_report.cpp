@@ -963,6 +963,8 @@ pre { white-space: pre-wrap; word-break: break-word; margin: 0.3em 0;
 figure { margin: 1.2em 0; max-width: 100%; overflow-x: auto; }
 #suite figure { margin: 0.4em 0; }
 .panels { display: flex; flex-wrap: wrap; gap: 0.8em; align-items: flex-start; }
+.frames { display: flex; flex-wrap: wrap; gap: 0.8em; }
+.frames img { max-width: 100%; height: auto; border: 1px solid #ccc; }
 .panels.stacked { flex-direction: column; flex-wrap: nowrap; }
 svg { max-width: none; height: auto; flex: none; }
 @media (max-width: 600px) {
@@ -1218,7 +1220,80 @@ std::string dose_figure(PageBuilder& page, std::size_t index, const CaseResult& 
     return figure + "</figure>\n";
 }
 
-std::string case_section(PageBuilder& page, std::size_t index, const CaseResult& result, const CaseFigures* figures) {
+// Seed 001's vision: the cover each ROI truly had and what the controller
+// measured, as two maps of the ROI centres side by side.
+std::optional<Panel> vision_map_panel(const std::vector<VisionRoiSample>& rois, bool measured) {
+    std::vector<std::vector<double>> data;
+    Extent east, north;
+    for (const VisionRoiSample& roi : rois) {
+        const double value = measured ? roi.measured_pct : roi.true_pct;
+        east.include(roi.east_m);
+        north.include(roi.north_m);
+        if (std::isfinite(value)) data.push_back({roi.east_m, roi.north_m, value});
+    }
+    if (east.empty()) return std::nullopt;
+    Panel panel;
+    panel.caption = measured ? "Cover D per ROI as the controller measured it" : "Cover D per ROI, truth";
+    panel.width = 420;
+    panel.height = 520;
+    std::string& script = panel.script;
+    script += data_block("rois", data);
+    script += "set title " + gnuplot_string(measured ? "measured (controller)" : "true (crop map)") + "\n";
+    script += "set xlabel " + gnuplot_string("east (m)") + "\nset ylabel " + gnuplot_string("north (m)") + "\n";
+    script += "set xrange " + east.range(0.1, 0.1) + "\nset yrange " + north.range(0.02, 0.02) + "\n";
+    script += "set cbrange [0:80]\nset cblabel " + gnuplot_string("cover D (%)") + "\n";
+    script += "set palette defined (0 '#8c6d46', 40 '#e8d36a', 80 '#1f7a2e')\nunset key\n";
+    script += data.empty() ? "plot NaN notitle\n" : "plot $rois using 1:2:3 with points pt 5 ps 0.9 lc palette notitle\n";
+    return panel;
+}
+
+std::string vision_figure(PageBuilder& page, std::size_t index, const CaseResult& result, const CaseFigures& figures,
+                          const HtmlReportOptions& options) {
+    if (figures.vision_rois.empty() && figures.vision_frames.empty()) return {};
+    std::string figure = "<figure class=\"figure vision\" id=\"" + case_anchor(index) + "-vision\">\n";
+    if (!figures.vision_frames.empty()) {
+        figure += "<div class=\"frames\">\n";
+        for (const VisionFrameImage& frame : figures.vision_frames) {
+            std::filesystem::path link = frame.file;
+            if (!options.report_dir.empty()) {
+                std::error_code ignored;
+                const std::filesystem::path relative = std::filesystem::relative(
+                    std::filesystem::absolute(frame.file, ignored), std::filesystem::absolute(options.report_dir, ignored), ignored);
+                if (!relative.empty()) link = relative;
+            }
+            std::string densities;
+            for (const VisionRoiSample& roi : frame.rois) {
+                densities += " nozzle " + std::to_string(roi.nozzle) + ": true " + shown_number(roi.true_pct, 3) +
+                             " %, measured " +
+                             (std::isfinite(roi.measured_pct) ? shown_number(roi.measured_pct, 3) + " %" : std::string("none")) + ";";
+            }
+            figure += "<figure class=\"frame\"><img src=\"" + html(link.generic_string()) +
+                      "\" width=\"640\" alt=\"" + html((frame.camera == 0 ? "left" : "right") + std::string(" camera frame ") +
+                                                      std::to_string(frame.frame_number)) +
+                      "\"><figcaption>" + (frame.camera == 0 ? "Left" : "Right") + " camera, frame " +
+                      std::to_string(frame.frame_number) + ":" + html(densities) + "</figcaption></figure>\n";
+        }
+        figure += "</div>\n";
+    }
+    figure += "<div class=\"panels\">\n";
+    for (const bool measured : {false, true}) {
+        if (std::optional<Panel> map = vision_map_panel(figures.vision_rois, measured)) {
+            map->what = case_label(index, result) + (measured ? ": measured cover map" : ": true cover map");
+            figure += page.place(std::move(*map));
+        }
+    }
+    figure += "</div>\n<figcaption>Seed 001's vision: each camera's frame from the middle of the run with every "
+              "nozzle's Sec. 2.1 ROI (600 x 400 mm, 200-600 mm ahead of the nozzle) outlined where it truly lies; "
+              "below, the cover D of every ROI of every frame at its centre, from the crop truth and as the "
+              "controller measured it (Eq. 15-17). A ROI without a measurement is left out of the second map.";
+    if (const std::optional<double> error = metric(result, "vision_worst_camera_density_error_mean_abs_pct")) {
+        figure += " Worst camera's mean |error| " + shown_number(*error, 3) + " points of cover.";
+    }
+    return figure + "</figcaption>\n</figure>\n";
+}
+
+std::string case_section(PageBuilder& page, std::size_t index, const CaseResult& result, const CaseFigures* figures,
+                         const HtmlReportOptions& options) {
     std::string section = "<section class=\"case\" id=\"" + case_anchor(index) + "\">\n";
     section += "<h2>" + std::to_string(index + 1) + ". " + html(result.name) + " " + verdict_badge(verdict_of(result)) +
                "</h2>\n";
@@ -1241,10 +1316,11 @@ std::string case_section(PageBuilder& page, std::size_t index, const CaseResult&
     if (figures != nullptr) {
         drawn += flow_figure(page, index, result, *figures);
         drawn += dose_figure(page, index, result, *figures);
+        drawn += vision_figure(page, index, result, *figures, options);
         if (!figures->jitter.empty()) drawn += "<h3>Timing jitter</h3>\n" + jitter_table(figures->jitter);
     }
     if (!result.board_io.is_null()) drawn += "<h3>Board I/O (Modbus)</h3>\n" + board_io_table(result.board_io);
-    if (drawn.empty()) drawn = "<p class=\"muted\">No flow, dose or jitter data was recorded for this case.</p>\n";
+    if (drawn.empty()) drawn = "<p class=\"muted\">No flow, dose, vision or jitter data was recorded for this case.</p>\n";
     section += drawn;
     section += "<p class=\"nav\"><a href=\"#cases\">\u2191 case table</a></p>\n</section>\n";
     return section;
@@ -1327,7 +1403,7 @@ HtmlReport render_html_report(const std::vector<CaseResult>& results, const std:
     std::string body = "<section id=\"cases\">\n<h2>Cases</h2>\n" + summary_table(results) + "</section>\n";
     body += suite_section(page, results);
     for (std::size_t i = 0; i < results.size(); ++i) {
-        body += case_section(page, i, results[i], i < figures.size() ? &figures[i] : nullptr);
+        body += case_section(page, i, results[i], i < figures.size() ? &figures[i] : nullptr, options);
     }
     draw_panels(page.panels(), options);
     const std::vector<std::string> problems = panel_problems(page.panels());
@@ -1359,7 +1435,9 @@ HtmlReport render_html_report(const std::vector<CaseResult>& results, const std:
 std::vector<std::string> write_html_report(const std::filesystem::path& file, const std::vector<CaseResult>& results,
                                            const std::vector<CaseFigures>& figures, const RunSummary& summary,
                                            const HtmlReportOptions& options) {
-    HtmlReport report = render_html_report(results, figures, summary, options);
+    HtmlReportOptions with_dir = options;
+    if (with_dir.report_dir.empty()) with_dir.report_dir = file.parent_path();
+    HtmlReport report = render_html_report(results, figures, summary, with_dir);
     write_file_atomically(file, report.html);
     return std::move(report.problems);
 }

@@ -47,6 +47,23 @@ struct JitterRow {
 };
 
 // What one case recorded for its figures; a figure is drawn only when it has data.
+// Seed 001's vision: one nozzle ROI of one frame, true and measured cover.
+struct VisionRoiSample {
+    int camera = 0;
+    int nozzle = 0;
+    double east_m = 0.0;              // the true ROI's centre, local frame
+    double north_m = 0.0;
+    double true_pct = 0.0;            // true cover D, %
+    double measured_pct = kNotMeasured;  // the controller's D, %; NaN when it gave none
+};
+// A camera frame kept for the report (a PNG beside the trace, the true ROIs drawn on it).
+struct VisionFrameImage {
+    int camera = 0;
+    long frame_number = 0;
+    std::filesystem::path file;       // where the PNG is (as the trace's directory was named)
+    std::vector<VisionRoiSample> rois;   // that frame's
+};
+
 struct CaseFigures {
     double target_flow_l_min = kNotMeasured;  // NaN: no flow control in this case
     double breakpoint_along_m = 0.0;
@@ -59,6 +76,8 @@ struct CaseFigures {
     std::vector<DoseSample> dose;
     std::vector<AreaSpan> areas;
     std::vector<JitterRow> jitter;
+    std::vector<VisionRoiSample> vision_rois;    // every frame's
+    std::vector<VisionFrameImage> vision_frames;
 };
 
 struct HtmlReportOptions {
@@ -71,6 +90,9 @@ struct HtmlReportOptions {
     // Where the scratch directory for gnuplot's script and output goes; empty:
     // std::filesystem::temp_directory_path(). Removed afterwards.
     std::filesystem::path scratch_parent;
+    // The report's directory: images beside the traces are linked relative to
+    // it. Empty: linked by the path the figures hold (write_html_report sets it).
+    std::filesystem::path report_dir;
 };
 
 struct HtmlReport {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -500,6 +501,55 @@ void apply_rig_overload(CaseResult& result) {
 
 }  // namespace
 
+namespace {
+
+// Seed 001's vision: every ROI's true and measured cover, and the frames the
+// run kept for the report (meta vision_report_frames, PNGs beside the trace).
+void add_vision_figures(const RecordedTrace& trace, CaseFigures& figures) {
+    const auto views = trace.samples.find(topics::kCameraViewTruth);
+    if (views == trace.samples.end()) return;
+    std::map<std::pair<int, long>, std::map<int, double>> measured;  // (camera, frame) -> nozzle -> D
+    if (const auto reports = trace.samples.find(topics::kVisionReport); reports != trace.samples.end()) {
+        for (const RecordedSample& s : reports->second) {
+            std::map<int, double>& by_nozzle =
+                measured[{s.json.at("camera").get<int>(), s.json.at("frame_number").get<long>()}];
+            for (const nlohmann::json& n : s.json.at("nozzles")) {
+                if (n.at("measured").get<bool>()) by_nozzle.emplace(n.at("nozzle").get<int>(), n.at("density").get<double>());
+            }
+        }
+    }
+    std::map<std::pair<int, long>, std::vector<VisionRoiSample>> by_frame;
+    for (const RecordedSample& s : views->second) {
+        const int camera = s.json.at("camera").get<int>();
+        const long frame = s.json.at("frame_number").get<long>();
+        const auto found = measured.find({camera, frame});
+        for (const nlohmann::json& n : s.json.at("nozzles")) {
+            VisionRoiSample roi;
+            roi.camera = camera;
+            roi.nozzle = n.at("nozzle").get<int>();
+            roi.east_m = n.at("roi_centre_east_m").get<double>();
+            roi.north_m = n.at("roi_centre_north_m").get<double>();
+            roi.true_pct = 100.0 * n.at("density").get<double>();
+            if (found != measured.end()) {
+                if (const auto d = found->second.find(roi.nozzle); d != found->second.end()) roi.measured_pct = 100.0 * d->second;
+            }
+            figures.vision_rois.push_back(roi);
+            by_frame[{camera, frame}].push_back(roi);
+        }
+    }
+    const nlohmann::json kept = nlohmann::json::parse(meta_or(trace, "vision_report_frames", "[]"));
+    for (const nlohmann::json& k : kept) {
+        VisionFrameImage image;
+        image.camera = k.at("camera").get<int>();
+        image.frame_number = k.at("frame_number").get<long>();
+        image.file = trace.file.parent_path() / k.at("file").get<std::string>();
+        image.rois = by_frame[{image.camera, image.frame_number}];
+        figures.vision_frames.push_back(std::move(image));
+    }
+}
+
+}  // namespace
+
 CaseRun judge_trace(const RecordedTrace& trace) {
     CaseRun run;
     CaseResult& result = run.result;
@@ -584,7 +634,10 @@ CaseRun judge_trace(const RecordedTrace& trace) {
             add_dose_figure(trace.dose, deposition, plan.breakpoint_along_m, plan.deposition.cv_window_m, figures);
         }
         // Seed 001's boundary cases (harness/boundary_judge.h).
-        if (plan.scenario == "boundary") metrics.merge(boundary_trace_metrics(trace, boundary_judging_plan_from_json(judging.at("boundary"))));
+        if (plan.scenario == "boundary") {
+            metrics.merge(boundary_trace_metrics(trace, boundary_judging_plan_from_json(judging.at("boundary"))));
+            add_vision_figures(trace, figures);
+        }
         metrics.merge(gnss_wire_fault_metrics(trace));  // cases with gnss.wire_faults only
         result.metrics = metrics.values;
         result.not_measured = metrics.not_measured;

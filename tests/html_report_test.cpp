@@ -385,7 +385,7 @@ TEST(HtmlReport, ExpectedFailureIsShownAsSuchWithoutFigures) {
               std::string::npos);
     EXPECT_NE(report.html.find("<li>overlap_m 3.61 &gt; 3.3 <span class=\"expected\">(expected)</span></li>"),
               std::string::npos);
-    EXPECT_NE(report.html.find("No flow, dose or jitter data was recorded for this case."), std::string::npos);
+    EXPECT_NE(report.html.find("No flow, dose, vision or jitter data was recorded for this case."), std::string::npos);
     EXPECT_NE(report.html.find("<p class=\"verdict pass\">All 1 case passed</p>"), std::string::npos);
     EXPECT_EQ(report.html.find("<svg"), std::string::npos);
 }

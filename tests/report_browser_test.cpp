@@ -33,10 +33,12 @@ constexpr double kSmallestLegiblePx = 9.0;
 TEST(ReportInABrowser, ReadableAtPhoneAndDesktopWidthWithoutErrors) {
     const fs::path dir = fresh_dir("report-browser");
     const fs::path out = dir / "out";
-    // A passing continuation and a failing faulty controller: every kind of section the report has.
+    // A passing continuation, a failing faulty controller and a seed-001 vision
+    // case (a camera frame and the cover maps): every kind of section the report has.
     const auto run = run_shell(quoted(RIG_BINARY_DIR "/bin/rig") + " run " +
                             quoted(RIG_SOURCE_DIR "/cases/table5-6-continuation/continuation-6kmh.yaml") + " " +
-                            quoted(RIG_SOURCE_DIR "/cases/faulty-controllers/never-resumes.yaml") + " --out " +
+                            quoted(RIG_SOURCE_DIR "/cases/faulty-controllers/never-resumes.yaml") + " " +
+                            quoted(RIG_SOURCE_DIR "/cases/seed001-vision-faults/dead-camera.yaml") + " --out " +
                             quoted(out) + " 2>&1");
     ASSERT_TRUE(fs::exists(out / "report.html")) << run.output;
 
