@@ -65,6 +65,13 @@ void render_frames(benchmark::State& state, CameraEmulatorParams params) {
 
 void BM_RenderFrame(benchmark::State& state) { render_frames(state, rig::emulators::vision::seed001_camera_params(false)); }
 
+// As the vision cases render (cases/seed001-table4-6-vision: one sample a pixel).
+void BM_RenderFrameOneSample(benchmark::State& state) {
+    CameraEmulatorParams params = rig::emulators::vision::seed001_camera_params(false);
+    params.samples_per_axis = 1;
+    render_frames(state, params);
+}
+
 void BM_RenderFrameDirtyLens(benchmark::State& state) {
     CameraEmulatorParams params = rig::emulators::vision::seed001_camera_params(false);
     params.faults.blur_radius_px = 4;
@@ -171,6 +178,7 @@ void BM_DeliverFrameOverDdsAcrossProcesses(benchmark::State& state) {
 }
 
 BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+BENCHMARK(BM_RenderFrameOneSample)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK(BM_RenderFrameDirtyLens)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK(BM_MeasureFrame)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 BENCHMARK(BM_DeliverFrameOverDds)->Unit(benchmark::kMillisecond)->MinTime(3.0)->UseRealTime();
