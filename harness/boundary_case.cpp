@@ -123,6 +123,13 @@ void read_camera_common(const YamlSection& s, emulators::vision::CameraEmulatorP
     }
 }
 
+// How the camera truly sits (the controller keeps Sec. 1.1's design as its
+// belief): turned on its mount, it is what the board calibration corrects.
+void read_camera_mounting(const YamlSection& s, rig::camera::CameraMounting& mounting) {
+    read(s, "yaw_deg", mounting.yaw_deg);
+    read(s, "roll_deg", mounting.roll_deg);
+}
+
 void read_camera_faults(const YamlSection& s, emulators::vision::CameraFaults& faults) {
     read(s, "pitch_offset_deg", faults.pitch_offset_deg);
     faults.blur_radius_px = s.optional_in_range<int>("blur_radius_px", faults.blur_radius_px, Bounds::closed(0, 50));
@@ -167,6 +174,10 @@ BoundaryVisionSpec read_vision(const YamlSection& s) {
     read_camera_common(cameras, vision.right);
     read_camera_faults(s.section("left").section("faults"), vision.left.faults);
     read_camera_faults(s.section("right").section("faults"), vision.right.faults);
+    read_camera_mounting(s.section("left").section("mounting"), vision.left.camera.mounting);
+    read_camera_mounting(s.section("right").section("mounting"), vision.right.camera.mounting);
+    vision.calibration_until_s = s.section("calibration").optional_in_range<double>("until_s", vision.calibration_until_s,
+                                                                                      Bounds::closed(0, 600));
     return vision;
 }
 
@@ -348,7 +359,11 @@ RawYaml controller_section_with_area(const RawYaml& controller, const BoundaryCa
     if (!(controller.present && controller.node.IsMap())) out.node = YAML::Node(YAML::NodeType::Map);
     out.present = true;
     // The cameras are on the rig: the reference controller uses them unless told otherwise.
-    if (spec.vision && !out.node["vision"]) out.node["vision"]["enabled"] = true;
+    if (spec.vision && !out.node["vision"]) {
+        out.node["vision"]["enabled"] = true;
+        // ... and calibrates from the boards while the case shows them.
+        if (spec.vision->calibration_until_s > 0.0) out.node["vision"]["calibration_until_s"] = spec.vision->calibration_until_s;
+    }
     if (out.node["areas"]) return out;
     YAML::Node area;
     area["name"] = spec.area_name;

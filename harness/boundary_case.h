@@ -65,6 +65,11 @@ struct BoundaryVisionSpec {
     // two cameras, seed001_camera_params() unless the case says otherwise.
     emulators::vision::CameraEmulatorParams left = emulators::vision::seed001_camera_params(false);
     emulators::vision::CameraEmulatorParams right = emulators::vision::seed001_camera_params(true);
+    // Sec. 2.2.1's calibration scene: until this time (s from t = 0) the
+    // cameras see the boards on the boom (a green board in front of each
+    // camera, a red board over each nozzle) instead of the bare crop, as while
+    // the operator calibrates standing at the headland. 0: no calibration. [0, 600] s
+    double calibration_until_s = 0.0;
 };
 
 struct BoundaryCaseSpec {

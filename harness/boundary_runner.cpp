@@ -137,7 +137,8 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                 }
                 cameras.push_back(std::make_unique<CameraNode>(world.kinematics, *world.crop,
                                                                camera == 0 ? world.vision->left : world.vision->right,
-                                                               seed, camera, nozzles, right_m));
+                                                               seed, camera, nozzles, right_m,
+                                                               seconds_to_ns(world.vision->calibration_until_s)));
                 // The report shows each camera's frame from the middle of the run.
                 cameras.back()->keep_frame_at(world.end_ns / 2);
                 nodes.push_back(cameras.back().get());
@@ -153,11 +154,12 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
             nodes.push_back(&pwm_capture.emplace(hid->board(), boundary.flow_table_or_paper().nozzle_count(),
                                                  spec.wiring.board_update_hz));
         }
-        // A wired Pi whose PWM comes on DDS (board_io: dds) must know the run's domain.
+        // A wired Pi whose PWM comes on DDS (board_io: dds), or that takes the
+        // camera frames (which travel on DDS only), must know the run's domain.
         if (spec.wiring.external_controller) {
-            const bool pwm_on_dds = spec.wiring.board_io == BoardIoWireKind::dds;
+            const bool on_dds = spec.wiring.board_io == BoardIoWireKind::dds || world.vision.has_value();
             announce_attach(spec, wires, run_name, case_dir, std::cout,
-                            pwm_on_dds ? std::optional<std::uint32_t>(session.domain_id()) : std::nullopt);
+                            on_dds ? std::optional<std::uint32_t>(session.domain_id()) : std::nullopt);
         }
 
         TimeNs now_ns = 0;

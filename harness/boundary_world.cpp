@@ -8,6 +8,7 @@
 
 #include "idl/topics.h"
 #include "rig/camera/png_file.h"
+#include "rig/runtime/realtime.h"
 
 namespace rig::harness {
 
@@ -183,20 +184,32 @@ std::string sha256_hex(const std::vector<std::uint8_t>& bytes) {
 
 CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
                        emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
-                       std::vector<int> nozzles, std::vector<double> nozzle_right_m)
+                       std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns)
     : name_(camera_index == 0 ? "camera_left" : "camera_right"),
       kinematics_(kinematics),
-      crop_(crop),
       emulator_(params, seed, static_cast<std::uint64_t>(camera_index), name_),
       camera_index_(camera_index),
       nozzles_(std::move(nozzles)),
       nozzle_right_m_(std::move(nozzle_right_m)),
-      frame_rate_hz_(params.frame_rate_hz) {}
+      frame_rate_hz_(params.frame_rate_hz),
+      calibration_until_ns_(calibration_until_ns),
+      render_crop_(crop.params(), crop.seed()) {
+    // The operator lays the green board in front of the camera (where it was
+    // designed to sit: a turned camera sees it turned) and a red board over
+    // each nozzle.
+    boards_.boom_board_right_m = params.camera.mounting.right_m;
+    boards_.nozzle_right_m = nozzle_right_m_;
+}
 
 void CameraNode::configure(DdsContext& dds) {
     frame_writer_ = std::make_unique<Writer<msg::CameraFrame>>(
         dds, camera_index_ == 0 ? topics::kCameraLeftFrame : topics::kCameraRightFrame);
     truth_writer_ = std::make_unique<Writer<msg::CameraViewTruth>>(dds, topics::kCameraViewTruth);
+    // Frame 0 is rendered before time starts: the first frame builds the crop
+    // truth's tiles in view, and a real-time run must not stall at t = 0 on it.
+    std::promise<Rendered> first;
+    first.set_value(render(0));
+    ahead_.emplace_back(0, first.get_future());
 }
 
 TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
@@ -204,37 +217,58 @@ TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
     return static_cast<TimeNs>(std::llround(static_cast<double>(k) * 1e9 / frame_rate_hz_));
 }
 
+CameraNode::Rendered CameraNode::render(std::uint64_t k) const {
+    // On the rendering thread, which the real-time loop may have started at its
+    // own SCHED_FIFO priority: rendering must not take a core from the loop.
+    drop_to_time_sharing();
+    Rendered out;
+    const TimeNs t_ns = frame_time_ns(k);
+    out.truth = kinematics_.truth_at(ns_to_seconds(t_ns));
+    const emulators::vision::BoomPose pose = emulators::vision::boom_pose_of(out.truth);
+    out.image = t_ns < calibration_until_ns_ ? emulator_.render_calibration(render_crop_, pose, boards_, k)
+                                             : emulator_.render(render_crop_, pose, k);
+    if (out.image) out.sha256 = sha256_hex(out.image->bytes);
+    msg::CameraViewTruth& view = out.view;
+    view.time_ns(t_ns);
+    view.camera(static_cast<std::uint16_t>(camera_index_));
+    view.frame_number(static_cast<std::uint32_t>(k));
+    view.delivered(out.image.has_value());
+    view.rgb_sha256(out.sha256);
+    view.speed_m_s(out.truth.pose.speed_m_s);
+    view.boom_height_m(out.truth.boom_height_m);
+    for (std::size_t i = 0; i < nozzles_.size(); ++i) {
+        const std::array<field2d::Vec2, 4> roi =
+            field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, nozzle_right_m_[i]);
+        msg::NozzleRoiTruth nozzle;
+        nozzle.nozzle(static_cast<std::uint16_t>(nozzles_[i]));
+        nozzle.density(render_crop_.cover_fraction(roi));
+        nozzle.roi_centre_east_m((roi[0].east_m + roi[1].east_m + roi[2].east_m + roi[3].east_m) / 4.0);
+        nozzle.roi_centre_north_m((roi[0].north_m + roi[1].north_m + roi[2].north_m + roi[3].north_m) / 4.0);
+        view.nozzles().push_back(nozzle);
+    }
+    return out;
+}
+
 TimeNs CameraNode::step(TimeNs now_ns) {
     while (frame_time_ns(frame_count_) <= now_ns) {
         const TimeNs t_ns = frame_time_ns(frame_count_);
-        const field2d::SprayerTruth truth = kinematics_.truth_at(ns_to_seconds(t_ns));
-        const emulators::vision::BoomPose pose = emulators::vision::boom_pose_of(truth);
-        const std::optional<rig::camera::RgbImage> image = emulator_.render(crop_, pose, frame_count_);
-
-        msg::CameraViewTruth view;
-        view.time_ns(t_ns);
-        view.camera(static_cast<std::uint16_t>(camera_index_));
-        view.frame_number(static_cast<std::uint32_t>(frame_count_));
-        view.delivered(image.has_value());
-        view.speed_m_s(truth.pose.speed_m_s);
-        view.boom_height_m(truth.boom_height_m);
-        for (std::size_t i = 0; i < nozzles_.size(); ++i) {
-            const std::array<field2d::Vec2, 4> roi =
-                field2d::nozzle_roi_ground(pose.boom_centre_ground, pose.heading_deg, nozzle_right_m_[i]);
-            msg::NozzleRoiTruth nozzle;
-            nozzle.nozzle(static_cast<std::uint16_t>(nozzles_[i]));
-            nozzle.density(crop_.cover_fraction(roi));
-            nozzle.roi_centre_east_m((roi[0].east_m + roi[1].east_m + roi[2].east_m + roi[3].east_m) / 4.0);
-            nozzle.roi_centre_north_m((roi[0].north_m + roi[1].north_m + roi[2].north_m + roi[3].north_m) / 4.0);
-            view.nozzles().push_back(nozzle);
+        // The frame rendered ahead (an exception there comes out here), or now.
+        // Keep the next frames rendering (an exception there comes out at its get()).
+        for (std::uint64_t k = ahead_.empty() ? frame_count_ : ahead_.back().first + 1; k <= frame_count_ + kRenderAhead; ++k) {
+            ahead_.emplace_back(k, std::async(std::launch::async, [this, k] { return render(k); }));
         }
+        if (ahead_.front().first != frame_count_) throw std::logic_error(name_ + ": frames rendered out of order");
+        Rendered rendered = ahead_.front().second.get();
+        ahead_.pop_front();
+
+        const field2d::SprayerTruth& truth = rendered.truth;
+        const std::optional<rig::camera::RgbImage>& image = rendered.image;
         if (image && keep_at_ns_ && !kept_frame_ && t_ns >= *keep_at_ns_) {
             kept_frame_ = *image;
             kept_frame_number_ = frame_count_;
             kept_boom_height_m_ = truth.boom_height_m;
         }
         if (image) {
-            view.rgb_sha256(sha256_hex(image->bytes));
             msg::CameraFrame frame;
             frame.frame_number(static_cast<std::uint32_t>(frame_count_));
             frame.width_px(static_cast<std::uint16_t>(image->width));
@@ -242,7 +276,7 @@ TimeNs CameraNode::step(TimeNs now_ns) {
             frame.rgb(image->bytes);
             frame_writer_->publish(frame);
         }
-        truth_writer_->publish(view);
+        truth_writer_->publish(rendered.view);
         ++frame_count_;
     }
     return frame_time_ns(frame_count_);

@@ -13,7 +13,9 @@
 //                      its nozzles' ROIs on truth/camera_view.
 // A pure function of the case and the seed: same seed, same trace.
 #include <cstdint>
+#include <deque>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -116,13 +118,25 @@ private:
 // is dead with no_frame), and on truth/camera_view the true cover D of each of
 // its nozzles' Sec. 2.1 ROIs (from the plant's true nozzle points; the
 // controller's ROIs are its own estimate of these) with the frame's SHA-256.
+// Rendering (30-60 ms a frame, more where new crop tiles are built) runs two
+// frames ahead, on threads of its own:
+// what a frame shows depends on the plant's boom pose at its instant, which
+// the route fixes in advance (the controller drives no part of it), so frame
+// k + 1 and k + 2 are rendered while the run goes on to them. The frame is the same either
+// way (a pure function of case, seed and frame number); the real-time loop
+// then does not stall on it, and lockstep runs render beside the rounds. The
+// thread reads its own copy of the crop truth (the map builds its raster
+// tiles on first use and is not shared between threads), and also counts the
+// true cover under the ROIs there: a real-time step only publishes.
 class CameraNode final : public Node {
 public:
     // camera_index 0 = left (device/camera_left/frame), 1 = right; `nozzles`
     // the nozzle numbers it sees; nozzle_right_m each one's place across the boom.
+    // Frames exposed before calibration_until_ns show Sec. 2.2.1's boards
+    // (a green board in front of the camera, a red one over each of its nozzles).
     CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
                emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
-               std::vector<int> nozzles, std::vector<double> nozzle_right_m);
+               std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns = 0);
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
@@ -137,16 +151,29 @@ public:
     std::optional<std::uint64_t> write_report_frame(const std::filesystem::path& file) const;
 
 private:
+    struct Rendered {
+        std::optional<rig::camera::RgbImage> image;  // nullopt: a dead camera sent nothing
+        std::string sha256;                          // of image->bytes
+        field2d::SprayerTruth truth;                 // the plant at the exposure
+        msg::CameraViewTruth view;                   // the crop truth under the ROIs, and the above
+    };
     TimeNs frame_time_ns(std::uint64_t k) const;
+    Rendered render(std::uint64_t k) const;
 
     std::string name_;
     const field2d::SprayerKinematics& kinematics_;
-    const field2d::CropCoverMap& crop_;
     emulators::vision::CameraEmulator emulator_;
     int camera_index_;
     std::vector<int> nozzles_;
     std::vector<double> nozzle_right_m_;
     double frame_rate_hz_;
+    TimeNs calibration_until_ns_;
+    emulators::vision::CalibrationBoards boards_;
+    field2d::CropCoverMap render_crop_;  // the rendering thread's own copy of the crop truth
+    // Frames being rendered, in frame order: the next kRenderAhead after the
+    // one last published, each on its own thread.
+    static constexpr std::uint64_t kRenderAhead = 2;
+    std::deque<std::pair<std::uint64_t, std::future<Rendered>>> ahead_;
     std::uint64_t frame_count_ = 0;
     std::optional<TimeNs> keep_at_ns_;
     std::optional<rig::camera::RgbImage> kept_frame_;

@@ -90,6 +90,34 @@ TEST(Seed001VisionCases, HealthyCamerasPassFaultsFailOnTheirMetricsAndTheJudgeAg
         << rig::testing::read_all(out / "judge.log");
 }
 
+// Sec. 2.2.1 in the loop: the left camera truly turned 3 deg on its mount.
+// Shown the boards while standing, the controller finds the nozzle points and
+// its ROIs land where Sec. 2.1 puts them; without the calibration they land
+// skewed and measure the wrong cover over the band edges.
+TEST(Seed001VisionCases, TheBoardCalibrationCorrectsATurnedCamera) {
+    const fs::path out = fresh_dir("calibration");
+    const std::string files = quoted(kCases / "seed001-vision-faults" / "calibrated-turned-camera.yaml") + " " +
+                              quoted(kCases / "seed001-vision-faults" / "uncalibrated-turned-camera.yaml");
+    ASSERT_EQ(rig("run " + files + " --jobs 2 --out " + quoted(out / "run"), out / "run.log"), 0)
+        << rig::testing::read_all(out / "run.log");
+    const nlohmann::json results = load_results(out / "run");
+    const nlohmann::json& calibrated = find_case(results, "seed001-vision-calibrated-turned-camera");
+    const nlohmann::json& uncalibrated = find_case(results, "seed001-vision-fault-uncalibrated-turned-camera");
+    ASSERT_TRUE(calibrated.at("passed").get<bool>()) << calibrated.dump(2);
+    EXPECT_TRUE(uncalibrated.at("expected_failure").get<bool>()) << uncalibrated.dump(2);
+    EXPECT_EQ(failing_metrics(uncalibrated), std::set<std::string>{"vision_worst_camera_density_error_mean_abs_pct"});
+    const double with = calibrated.at("metrics").at("vision_camera0_density_error_mean_abs_pct").get<double>();
+    const double without = uncalibrated.at("metrics").at("vision_camera0_density_error_mean_abs_pct").get<double>();
+    EXPECT_LT(with, 0.5);
+    EXPECT_GT(without, 2.0 * with);
+    // The right camera is square: the same either way, within its noise.
+    EXPECT_LT(calibrated.at("metrics").at("vision_camera1_density_error_mean_abs_pct").get<double>(), 0.5);
+    // The controller says which camera calibrated and which refused a frame, and why.
+    EXPECT_EQ(rig::testing::read_all(out / "run" / "cases" / "seed001-vision-calibrated-turned-camera" / "controller.log")
+                  .find("calibration frame refused"),
+              std::string::npos);
+}
+
 TEST(Seed001VisionCases, SameSeedSameTraceAnotherSeedAnotherField) {
     const fs::path out = fresh_dir("digest");
     const std::string file = quoted(kCases / "seed001-table4-6-vision" / "sparse-1_5-m-s.yaml");

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <optional>
 
+#include "controller/boundary/vision/nozzle_calibration.h"
 #include "idl/topics.h"
 
 namespace rig::controller::boundary {
@@ -21,6 +22,8 @@ BoundaryControllerNode::BoundaryControllerNode(std::string node_name, BoundaryNo
             cameras_.emplace_back(std::move(camera), vision_config_.params, index++);
         }
         logic_.enable_vision(vision_config_.blind_level);
+        calibrated_.assign(cameras_.size(), false);
+        calibration_noticed_.assign(cameras_.size(), false);
         density_time_ns_.assign(static_cast<std::size_t>(config.controller.nozzle_count), -1);
     }
 }
@@ -54,7 +57,52 @@ bool BoundaryControllerNode::has_unread_input() const {
     return false;
 }
 
+void BoundaryControllerNode::calibrate(std::size_t camera, const msg::CameraFrame& frame, TimeNs now_ns) {
+    msg::VisionReport report;
+    report.time_ns(now_ns);
+    report.camera(static_cast<std::uint16_t>(camera));
+    report.frame_number(frame.frame_number());
+    report.threshold(-1);
+    report.speed_m_s(logic_.status().speed_m_s);
+    report.boom_height_m(logic_.status().boom_height_m);
+    rig::camera::RgbImage image;
+    image.width = frame.width_px();
+    image.height = frame.height_px();
+    image.bytes = frame.rgb();
+    vision::VisionCameraConfig config = cameras_[camera].camera();
+    if (image.bytes.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3U) {
+        report.status("calibration_bad");
+        notice_calibration(camera, "a calibration frame whose pixels do not fill its size");
+    } else {
+        const vision::NozzleCalibration found =
+            vision::find_nozzle_points(image, cameras_[camera].model(), config.nozzles.size());
+        if (found.ok) {
+            config.nozzle_pixels = found.nozzle_pixels;
+            // The nozzle points move Eq. 5-8's ROIs; nothing else of the camera changes.
+            cameras_[camera] = vision::CameraVision(config, vision_config_.params, camera);
+            calibrated_[camera] = true;
+            report.status("calibrated");
+        } else {
+            report.status("calibration_bad");
+            notice_calibration(camera, found.problem);
+        }
+    }
+    vision_writer_->publish(report);
+}
+
+void BoundaryControllerNode::notice_calibration(std::size_t camera, const std::string& problem) {
+    // Once per camera: a calibration scene shows for many frames.
+    if (calibration_noticed_[camera]) return;
+    calibration_noticed_[camera] = true;
+    std::cerr << name_ << ": " << cameras_[camera].camera().name << ": calibration frame refused (" << problem
+              << "); the " << (calibrated_[camera] ? "points found before" : "design nozzle points") << " stay\n";
+}
+
 void BoundaryControllerNode::process_frame(std::size_t camera, const msg::CameraFrame* frame, TimeNs now_ns) {
+    if (frame != nullptr && now_ns < seconds_to_ns(vision_config_.calibration_until_s)) {
+        calibrate(camera, *frame, now_ns);
+        return;
+    }
     const BoundaryStatus& status = logic_.status();
     std::optional<rig::camera::RgbImage> image;
     if (frame != nullptr) {

@@ -51,6 +51,10 @@ private:
     // Eq. 15-17 on a camera's frame (nullptr: none), the densities into the
     // logic, and its report. Returns whether any density changed.
     void process_frame(std::size_t camera, const msg::CameraFrame* frame, TimeNs now_ns);
+    // Sec. 2.2.1 on a frame of the calibration window: the nozzle points
+    // (Eq. 1-4) replace the camera's design points when the boards are found.
+    void calibrate(std::size_t camera, const msg::CameraFrame& frame, TimeNs now_ns);
+    void notice_calibration(std::size_t camera, const std::string& problem);
     // Densities older than vision.density_max_age_s are dropped (the camera
     // stopped); returns when the next one expires.
     TimeNs expire_densities(TimeNs now_ns);
@@ -74,7 +78,9 @@ private:
     std::vector<vision::CameraVision> cameras_;
     std::vector<std::unique_ptr<Reader<msg::CameraFrame>>> frame_readers_;
     std::unique_ptr<Writer<msg::VisionReport>> vision_writer_;
-    std::vector<TimeNs> density_time_ns_;  // per nozzle, when its density was measured (-1: none)
+    std::vector<TimeNs> density_time_ns_;
+    std::vector<bool> calibrated_;            // per camera: nozzle points found in a calibration frame
+    std::vector<bool> calibration_noticed_;   // per camera: a refused calibration frame was told  // per nozzle, when its density was measured (-1: none)
     std::vector<double> published_duty_pct_;
     bool published_once_ = false;
 };

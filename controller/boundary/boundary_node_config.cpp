@@ -75,6 +75,8 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     read_double(vision, "min_roi_share_in_frame", v.params.min_roi_share_in_frame);
     v.blind_level = vision.optional_in_range<int>("blind_level", v.blind_level, Bounds::closed(0, 2));
     v.density_max_age_s = vision.optional_in_range<double>("density_max_age_s", v.density_max_age_s, Bounds::open_closed(0, 60));
+    v.calibration_until_s =
+        vision.optional_in_range<double>("calibration_until_s", v.calibration_until_s, Bounds::closed(0, 600));
     try {
         vision::validate(v.params);
     } catch (const std::invalid_argument& error) {

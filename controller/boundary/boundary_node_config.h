@@ -40,6 +40,10 @@ struct VisionNodeConfig {
     // A density older than this (no newer frame) is no density: the camera
     // has stopped. Assumed 1 s, five frames at the cases' 5 fps. (0, 60] s
     double density_max_age_s = 1.0;
+    // Sec. 2.2.1: frames before this time (s) show the calibration boards;
+    // the nozzle points found in them (Eq. 1-4) replace the design points for
+    // Eq. 5-8. 0: no calibration, the design points. [0, 600] s
+    double calibration_until_s = 0.0;
 };
 
 struct BoundaryNodeConfig {

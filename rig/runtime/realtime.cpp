@@ -63,6 +63,13 @@ std::string raise_thread_to_realtime(std::thread& thread, int priority) {
     return error == 0 ? std::string() : std::string("SCHED_FIFO refused: ") + std::strerror(error);
 }
 
+std::string drop_to_time_sharing() {
+    sched_param param{};
+    param.sched_priority = 0;
+    const int error = pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
+    return error == 0 ? std::string() : std::string("SCHED_OTHER refused: ") + std::strerror(error);
+}
+
 RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), remotes_(dds, timeouts) {}
 
 RealtimeMaster::~RealtimeMaster() { shutdown(); }

@@ -62,6 +62,13 @@ SchedulingReport request_realtime_scheduling(int priority);
 // server or forwarder: threads started before request_realtime_scheduling()
 // do not inherit it). "" when granted, else why not.
 std::string raise_thread_to_realtime(std::thread& thread, int priority);
+// The calling thread back to ordinary time sharing (SCHED_OTHER): for a
+// worker that the real-time loop starts (threads inherit SCHED_FIFO) and that
+// computes for tens of milliseconds, such as a camera rendering its next
+// frame. At the loop's priority it would hold a core the loop needs; below
+// it, it takes what the loop leaves. Harmless when the thread was not
+// real-time. "" when done, else why not.
+std::string drop_to_time_sharing();
 
 class RealtimeMaster {
 public:
