@@ -221,6 +221,9 @@ CameraNode::Rendered CameraNode::render(std::uint64_t k) const {
     // On the rendering thread, which the real-time loop may have started at its
     // own SCHED_FIFO priority: rendering must not take a core from the loop.
     drop_to_time_sharing();
+    // Two frames may be in flight: one renders at a time. Which comes first
+    // does not matter: the crop truth is the same whatever is looked at first.
+    const std::lock_guard<std::mutex> one_at_a_time(render_mutex_);
     Rendered out;
     const TimeNs t_ns = frame_time_ns(k);
     out.truth = kinematics_.truth_at(ns_to_seconds(t_ns));

@@ -16,6 +16,7 @@
 #include <deque>
 #include <filesystem>
 #include <future>
+#include <mutex>
 #include <memory>
 #include <optional>
 #include <string>
@@ -169,7 +170,8 @@ private:
     double frame_rate_hz_;
     TimeNs calibration_until_ns_;
     emulators::vision::CalibrationBoards boards_;
-    field2d::CropCoverMap render_crop_;  // the rendering thread's own copy of the crop truth
+    field2d::CropCoverMap render_crop_;  // the rendering threads' own copy of the crop truth ...
+    mutable std::mutex render_mutex_;    // ... which one of them uses at a time (its tile cache is not thread-safe)
     // Frames being rendered, in frame order: the next kRenderAhead after the
     // one last published, each on its own thread.
     static constexpr std::uint64_t kRenderAhead = 2;
