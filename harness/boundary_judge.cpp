@@ -337,6 +337,8 @@ std::vector<RoiJudged> rois_from_trace(const RecordedTrace& trace, const VisionJ
             roi.camera = camera;
             roi.frame_number = frame;
             roi.nozzle = n.at("nozzle").get<int>();
+            roi.centre_east_m = east;
+            roi.centre_north_m = north;
             roi.true_density = n.at("density").get<double>();
             roi.true_speed_m_s = view.at("speed_m_s").get<double>();
             roi.delivered = view.at("delivered").get<bool>();
@@ -383,30 +385,45 @@ DoseCells dose_cells(const DoseRaster& total, const GroundRect& rect, const std:
 MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgingPlan& plan) {
     MetricSet metrics;
     const std::vector<NozzleStepTruth> steps = nozzle_step_truth(trace);
+    std::optional<DoseRaster> total;  // the ground, when something below needs it
+    if (plan.vision.enabled || !plan.papers.empty() || plan.dose_strip) total = sum_rasters(ground_from_truth(steps, plan));
     if (plan.vision.enabled) {
-        for (const auto& [name, value] : vision_metrics(rois_from_trace(trace, plan.vision), plan.vision, metrics.not_measured)) {
-            metrics.values[name] = value;
+        const std::vector<RoiJudged> rois = rois_from_trace(trace, plan.vision);
+        for (const auto& [name, value] : vision_metrics(rois, plan.vision, metrics.not_measured)) metrics.values[name] = value;
+        // The dose around each ROI's centre: a 0.2 m square, whatever the heading.
+        std::vector<double> doses;
+        for (const RoiJudged& roi : rois) {
+            const GroundRect square{roi.centre_east_m - 0.1, roi.centre_east_m + 0.1, roi.centre_north_m - 0.1,
+                                    roi.centre_north_m + 0.1};
+            try {
+                const DoseCells cells = dose_cells(*total, square, "ROI");
+                double sum = 0.0;
+                for (const double d : cells.dose_ul_cm2) sum += d;
+                doses.push_back(cells.dose_ul_cm2.empty() ? NAN : sum / static_cast<double>(cells.dose_ul_cm2.size()));
+            } catch (const std::runtime_error&) {
+                doses.push_back(NAN);  // off the judge's ground grid
+            }
         }
+        for (const auto& [name, value] : dose_by_cover_metrics(rois, doses)) metrics.values[name] = value;
     }
     if (!plan.papers.empty() || plan.dose_strip) {
-        const DoseRaster total = sum_rasters(ground_from_truth(steps, plan));
         std::vector<DoseCells> papers;
         for (std::size_t i = 0; i < plan.papers.size(); ++i) {
-            papers.push_back(dose_cells(total, paper_at(plan.papers[i].east_m, plan.papers[i].north_m),
+            papers.push_back(dose_cells(*total, paper_at(plan.papers[i].east_m, plan.papers[i].north_m),
                                         "papers[" + std::to_string(i) + "]"));
         }
         for (const auto& [name, value] : paper_metrics(papers, plan.coverage)) metrics.values[name] = value;
         if (plan.dose_strip) {
-            for (const auto& [name, value] : strip_metrics(dose_cells(total, *plan.dose_strip, "dose_strip"), plan.coverage)) {
+            for (const auto& [name, value] : strip_metrics(dose_cells(*total, *plan.dose_strip, "dose_strip"), plan.coverage)) {
                 metrics.values[name] = value;
             }
         }
     }
     if (!plan.edges.empty()) {
         const std::vector<DoseRaster> layers = ground_from_truth(steps, plan);
-        const DoseRaster total = sum_rasters(layers);
+        const DoseRaster ground = sum_rasters(layers);
         for (const BoundaryEdgePlan& e : plan.edges) {
-            const EdgeProfile profile = wet_edge_profile(total, e.edge, e.probe);
+            const EdgeProfile profile = wet_edge_profile(ground, e.edge, e.probe);
             for (const auto& [name, value] : excess_metrics(e.metric, profile)) metrics.values[name] = value;
             if (profile.excess_m.empty() || std::all_of(profile.excess_m.begin(), profile.excess_m.end(),
                                                         [](double x) { return std::isnan(x); })) {

@@ -133,6 +133,30 @@ std::map<std::string, double> vision_metrics(const std::vector<RoiJudged>& rois,
     return out;
 }
 
+std::map<std::string, double> dose_by_cover_metrics(const std::vector<RoiJudged>& rois,
+                                                    const std::vector<double>& dose_ul_cm2) {
+    if (dose_ul_cm2.size() != rois.size()) throw std::invalid_argument("dose by cover: one dose per ROI");
+    // Sec. 5.2 classes areas by the computed density: sparse below 40 %, normal above.
+    constexpr double kSparseBelow = 0.40;
+    double sparse_sum = 0.0, normal_sum = 0.0;
+    std::size_t sparse = 0, normal = 0;
+    for (std::size_t i = 0; i < rois.size(); ++i) {
+        if (!std::isfinite(dose_ul_cm2[i])) continue;
+        if (rois[i].true_density < kSparseBelow) {
+            sparse_sum += dose_ul_cm2[i];
+            ++sparse;
+        } else {
+            normal_sum += dose_ul_cm2[i];
+            ++normal;
+        }
+    }
+    std::map<std::string, double> out{{"vision_sparse_rois_count", static_cast<double>(sparse)},
+                                      {"vision_normal_rois_count", static_cast<double>(normal)}};
+    if (sparse > 0) out["vision_dose_sparse_rois_ul_cm2"] = sparse_sum / static_cast<double>(sparse);
+    if (normal > 0) out["vision_dose_normal_rois_ul_cm2"] = normal_sum / static_cast<double>(normal);
+    return out;
+}
+
 GroundRect paper_at(double east_m, double north_m) {
     constexpr double kAcrossM = 0.076;  // long side, east-west
     constexpr double kAlongM = 0.026;

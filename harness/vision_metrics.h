@@ -87,6 +87,8 @@ struct RoiJudged {
     int camera = 0;
     long frame_number = 0;
     int nozzle = 0;
+    double centre_east_m = 0.0;          // the true ROI's centre, local frame
+    double centre_north_m = 0.0;
     double true_density = 0.0;
     double true_speed_m_s = 0.0;
     bool delivered = true;               // the camera sent the frame
@@ -113,6 +115,18 @@ struct RoiJudged {
 // Metrics over an empty set are absent and named in `not_measured`.
 std::map<std::string, double> vision_metrics(const std::vector<RoiJudged>& rois, const VisionJudging& judging,
                                              std::map<std::string, std::string>& not_measured);
+
+// Dose per area against cover (Sec. 3: the rate follows the plants): the
+// dose the plant laid around each judged ROI's centre (`dose_ul_cm2[i]` for
+// rois[i]; NaN where the ground grid has none), averaged over the ROIs whose
+// true cover is below Sec. 5.2's 40 % split (sparse) and at or above it
+// (normal): vision_dose_sparse_rois_ul_cm2, vision_dose_normal_rois_ul_cm2,
+// and their counts vision_sparse_rois_count, vision_normal_rois_count. The
+// ground under a ROI is sprayed after the frame that saw it (0.13-0.4 s at
+// 1.5 m/s), by whatever level the frames then in force chose: across a cover
+// edge the two differ, the spatial offset S7 asks to report.
+std::map<std::string, double> dose_by_cover_metrics(const std::vector<RoiJudged>& rois,
+                                                    const std::vector<double>& dose_ul_cm2);
 
 // A ground rectangle (local frame, m): a water-sensitive paper or the strip
 // whose dose per area is judged.

@@ -115,6 +115,18 @@ TEST(VisionMetrics, NothingJudgedOrNothingMeasuredIsNamedNotZero) {
     EXPECT_EQ(m.count("vision_reports_missing_pct"), 0u);  // of delivered frames: none
 }
 
+TEST(VisionMetrics, DoseByCoverSplitsAtSec52s40Percent) {
+    const std::vector<RoiJudged> rois = {roi(0, 0.26, 0.26, 40.0), roi(0, 0.399, 0.4, 40.0), roi(1, 0.40, 0.4, 100.0),
+                                         roi(1, 0.56, 0.56, 100.0), roi(1, 0.56, 0.56, 100.0)};
+    const std::map<std::string, double> m = dose_by_cover_metrics(rois, {1.0, 0.5, 2.0, 1.5, std::nan("")});
+    EXPECT_EQ(m.at("vision_sparse_rois_count"), 2.0);
+    EXPECT_EQ(m.at("vision_normal_rois_count"), 2.0);  // the NaN dose (off the grid) is left out
+    EXPECT_DOUBLE_EQ(m.at("vision_dose_sparse_rois_ul_cm2"), 0.75);
+    EXPECT_DOUBLE_EQ(m.at("vision_dose_normal_rois_ul_cm2"), 1.75);
+    EXPECT_EQ(dose_by_cover_metrics({}, {}).count("vision_dose_sparse_rois_ul_cm2"), 0u);
+    EXPECT_THROW(dose_by_cover_metrics(rois, {1.0}), std::invalid_argument);
+}
+
 TEST(VisionMetrics, PapersAverageCoverageOverTheirCellsAndTheStripItsDose) {
     const CoverageModel model;
     // A paper half on a stripe (dose 2) and half off (0): its coverage is the
