@@ -8,7 +8,10 @@
 // Nothing here measures speed (vision_bench's BM_DeliverFrameOverDds does).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <filesystem>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -126,8 +129,12 @@ TEST(CameraFrameDds, FramesCrossTwoProcessesBitIdenticalInOrder) {
     rig::DdsContext dds(lease.domain_id(), "camera");
     rig::Writer<CameraFrame> out(dds, rig::topics::kCameraLeftFrame);
     rig::Reader<CameraFrame> back(dds, rig::topics::kCameraRightFrame);
+    // The echo's log in a folder of its own (GoogleTest's temp dir need not exist yet).
+    const std::filesystem::path logs =
+        std::filesystem::path(::testing::TempDir()) / ("camera-frame-dds-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(logs);
     rig::ChildProcess echo({RIG_CAMERA_FRAME_NODE, "--domain", std::to_string(lease.domain_id()), "--echo"},
-                           ::testing::TempDir() + "/camera-frame-echo.log");
+                           (logs / "echo.log").string());
     ASSERT_TRUE(wait_matched([&] { return out.matched_readers() >= 1 && back.matched_writers() >= 1; }))
         << echo.exit_description().value_or("echo still running");
 
