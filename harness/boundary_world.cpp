@@ -4,8 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <openssl/evp.h>
-
+#include "harness/sha256.h"
 #include "idl/topics.h"
 #include "rig/camera/png_file.h"
 #include "rig/runtime/realtime.h"
@@ -166,18 +165,9 @@ TimeNs L4LaserNode::step(TimeNs now_ns) {
 namespace {
 
 std::string sha256_hex(const std::vector<std::uint8_t>& bytes) {
-    unsigned char hash[EVP_MAX_MD_SIZE];
-    unsigned int length = 0;
-    if (EVP_Digest(bytes.data(), bytes.size(), hash, &length, EVP_sha256(), nullptr) != 1) {
-        throw std::runtime_error("camera frame: SHA-256 failed");
-    }
-    static const char* digits = "0123456789abcdef";
-    std::string hex;
-    for (unsigned int i = 0; i < length; ++i) {
-        hex += digits[hash[i] >> 4];
-        hex += digits[hash[i] & 15];
-    }
-    return hex;
+    Sha256 digest;
+    digest.add(bytes.data(), bytes.size());
+    return digest.hex();
 }
 
 }  // namespace

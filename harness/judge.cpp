@@ -1,6 +1,5 @@
 #include "harness/judge.h"
 
-#include <openssl/evp.h>
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 
 #include "emulators/field_frame.h"
 #include "harness/boundary_judge.h"
+#include "harness/sha256.h"
 #include "harness/trace_file.h"
 #include "harness/wire_fault_report.h"
 #include "idl/topics.h"
@@ -169,30 +169,6 @@ private:
     sqlite3* db_ = nullptr;
 };
 
-// SHA-256, as the trace file computes it.
-class Sha256 {
-public:
-    Sha256() : context_(EVP_MD_CTX_new()) { EVP_DigestInit_ex(context_, EVP_sha256(), nullptr); }
-    ~Sha256() { EVP_MD_CTX_free(context_); }
-    Sha256(const Sha256&) = delete;
-    Sha256& operator=(const Sha256&) = delete;
-    void add(const std::string& text) { EVP_DigestUpdate(context_, text.data(), text.size()); }
-    std::string hex() {
-        unsigned char hash[EVP_MAX_MD_SIZE];
-        unsigned int length = 0;
-        EVP_DigestFinal_ex(context_, hash, &length);
-        static const char* digits = "0123456789abcdef";
-        std::string text;
-        for (unsigned int i = 0; i < length; ++i) {
-            text += digits[hash[i] >> 4];
-            text += digits[hash[i] & 0xf];
-        }
-        return text;
-    }
-
-private:
-    EVP_MD_CTX* context_;
-};
 
 std::string column_text(sqlite3_stmt* statement, int column) {
     const unsigned char* text = sqlite3_column_text(statement, column);

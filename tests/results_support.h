@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "run_support.h"  // read_all
+
 namespace rig::testing {
 
 // `rig ARGS` with its output in `log`, bounded by `timeout_s` (a hung run fails
@@ -49,6 +51,23 @@ inline std::set<std::string> failing_metrics(const nlohmann::json& one_case) {
         metrics.insert(line.substr(0, line.find(' ')));
     }
     return metrics;
+}
+
+// The trace digest of one run of `case_file` at `seed` (`rig run` into `out`),
+// "" after a failed assertion (the run did not succeed, or gave no digest).
+inline std::string run_digest(const std::filesystem::path& case_file, int seed, const std::filesystem::path& out,
+                              int timeout_s = 600) {
+    const std::filesystem::path log = out.string() + ".log";
+    const int status = run_rig("run '" + case_file.string() + "' --seed " + std::to_string(seed) + " --out '" +
+                                   out.string() + "'",
+                               log, timeout_s);
+    if (status != 0) {
+        ADD_FAILURE() << "rig run exited " << status << ":\n" << read_all(log);
+        return {};
+    }
+    const std::string digest = load_results(out).at("cases").at(0).at("trace_sha256").get<std::string>();
+    EXPECT_FALSE(digest.empty()) << "no digest in " << out;
+    return digest;
 }
 
 }  // namespace rig::testing

@@ -91,22 +91,14 @@ TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
 
 TEST(Seed001Cases, SameSeedSameTraceAnotherSeedAnotherTrace) {
     const fs::path out = fresh_dir("digest");
-    const std::string file = "'" + (kCases / "seed001-table8-boundary" / "drive-in.yaml").string() + "'";
-    std::string digest[3];
-    const int seeds[3] = {2, 2, 3};
-    for (int i = 0; i < 3; ++i) {
-        const fs::path run = out / ("run" + std::to_string(i));
-        ASSERT_EQ(rig("run " + file + " --seed " + std::to_string(seeds[i]) + " --out '" + run.string() + "'",
-                      out / "run.log"),
-                  0)
-            << rig::testing::read_all(out / "run.log");
-        const nlohmann::json results = load_results(run);
-        digest[i] = results.at("cases").at(0).at("trace_sha256").get<std::string>();
-        ASSERT_FALSE(digest[i].empty());
-    }
-    EXPECT_EQ(digest[0], digest[1]);
+    const fs::path file = kCases / "seed001-table8-boundary" / "drive-in.yaml";
+    const std::string first = rig::testing::run_digest(file, 2, out / "run0", 600);
+    const std::string again = rig::testing::run_digest(file, 2, out / "run1", 600);
+    const std::string other = rig::testing::run_digest(file, 3, out / "run2", 600);
+    ASSERT_FALSE(first.empty());
+    EXPECT_EQ(first, again);
     // Another seed moves the epochs and the PWM phase: another trace.
-    EXPECT_NE(digest[0], digest[2]);
+    EXPECT_NE(first, other);
 }
 
 TEST(Seed001Cases, ABrokenBoundaryCaseIsRefusedNamingTheKey) {
