@@ -3,7 +3,9 @@
 // For each case, N runs in process mode (the controller in its own process)
 // and N in software-in-the-loop mode (its plugin in the rig's process), one at
 // a time; in the same invocation, a DDS ping-pong between two processes on the
-// rig's profile with the clock's own message types (rig/host/dds_pingpong.h).
+// rig's profile with the clock's own message types (rig/host/dds_pingpong.h),
+// once before each repeat of the process-mode runs, each repeat judged against
+// the ping-pong just before it.
 // One table: per mode, the wall time per round and rounds per second while
 // stepping, simulated over wall time per case, start-up to all matched (p50 /
 // p99), trace bytes per simulated minute, and the per-round cost as a ratio to
