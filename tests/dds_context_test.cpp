@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <memory>
 #include <string>
@@ -53,6 +54,38 @@ TEST(DdsContext, EndpointsOutlivingTheirContextAreDetachedNotDangling) {
     EXPECT_FALSE(reader->wait_for_data(std::chrono::milliseconds(1)));
     writer.reset();
     reader.reset();
+}
+
+// Start-up waits for matches on wait_for_matching_change (rig/runtime/lockstep.cpp):
+// each match and unmatch of a writer or reader must wake it, in the context of
+// the endpoint whose count changed. Without the wake-up every wait below runs
+// out its 10 s and returns false, and no change is counted.
+TEST(DdsContext, MatchingChangesWakeTheWaiterOnBothSides) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext writer_side(lease.domain_id(), "matching-writer");
+    rig::DdsContext reader_side(lease.domain_id(), "matching-reader");
+    rig::Writer<rig::msg::NmeaSentence> writer(writer_side, rig::topics::kDdsCheckPing);
+    const std::uint64_t writer_seen = writer_side.matching_change_count();
+    const std::uint64_t reader_seen = reader_side.matching_change_count();
+    auto reader = std::make_unique<rig::Reader<rig::msg::NmeaSentence>>(reader_side, rig::topics::kDdsCheckPing);
+
+    const auto wait_until = [](rig::DdsContext& dds, std::uint64_t seen, const std::function<bool()>& done) {
+        while (!done()) {
+            if (!dds.wait_for_matching_change(seen, std::chrono::seconds(10))) return false;
+            seen = dds.matching_change_count();
+        }
+        return true;
+    };
+    EXPECT_TRUE(wait_until(reader_side, reader_seen, [&] { return reader->matched_writers() == 1; }));
+    EXPECT_TRUE(wait_until(writer_side, writer_seen, [&] { return writer.matched_readers() == 1; }));
+    // Counted even when the match came before the wait began.
+    EXPECT_GT(reader_side.matching_change_count(), reader_seen);
+    EXPECT_GT(writer_side.matching_change_count(), writer_seen);
+
+    const std::uint64_t before_unmatch = writer_side.matching_change_count();
+    reader.reset();
+    EXPECT_TRUE(wait_until(writer_side, before_unmatch, [&] { return writer.matched_readers() == 0; }));
+    EXPECT_GT(writer_side.matching_change_count(), before_unmatch);
 }
 
 TEST(DdsContext, EndpointsDestroyedFirstLeaveTheRegistry) {

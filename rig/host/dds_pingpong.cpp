@@ -52,10 +52,12 @@ PingPongResult run_dds_pingpong(const PingPongOptions& options) {
 
     PingPongResult result;
     const WallStopwatch since_start;
-    while (ping.matched_readers() < 1 || pong.matched_writers() < 1) {
+    for (;;) {
+        const std::uint64_t seen = dds.matching_change_count();
+        if (ping.matched_readers() >= 1 && pong.matched_writers() >= 1) break;
         if (since_start.elapsed() > kMatchTimeout) return fail("the second process was not matched within 15 s");
         if (auto gone = echo.exit_description()) return fail("it ended before matching");
-        pong.wait_for_data(std::chrono::milliseconds(5));
+        dds.wait_for_matching_change(seen, std::chrono::milliseconds(50));
     }
     result.matched_after_s = since_start.elapsed_s();
 

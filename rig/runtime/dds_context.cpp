@@ -116,7 +116,7 @@ void delete_writer(dds::Publisher& publisher, dds::DataWriter* writer) {
 }  // namespace
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
-    : context_(&context), topic_name_(std::move(topic_name)), counts_as_output_(counts_as_output) {
+    : context_(&context), topic_name_(std::move(topic_name)), listener_(context), counts_as_output_(counts_as_output) {
     dds::DataWriterQos qos = project_writer_qos(context_->publisher());
     if (const std::uint32_t bound = max_serialized_size(context_->participant(), *topic); bound > kLargeTypeBytes) {
         apply_large_type_memory(qos);
@@ -171,6 +171,16 @@ bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
 }
 
 void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.notify_data_arrived(); }
+
+void ReaderBase::MatchListener::on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) {
+    matched.store(status.current_count);
+    context.notify_matching_changed();
+}
+
+void WriterBase::MatchListener::on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) {
+    matched.store(status.current_count);
+    context.notify_matching_changed();
+}
 
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
     : context_(&context), topic_name_(std::move(topic_name)), listener_(context) {
@@ -452,6 +462,24 @@ std::uint64_t DdsContext::arrival_count() {
 bool DdsContext::wait_for_arrival(std::uint64_t seen, std::chrono::steady_clock::time_point deadline) {
     std::unique_lock lock(arrival_mutex_);
     return arrival_.wait_until(lock, deadline, [&] { return arrivals_ != seen; });
+}
+
+void DdsContext::notify_matching_changed() {
+    {
+        std::lock_guard lock(arrival_mutex_);
+        ++matching_changes_;
+    }
+    matching_.notify_all();
+}
+
+std::uint64_t DdsContext::matching_change_count() {
+    std::lock_guard lock(arrival_mutex_);
+    return matching_changes_;
+}
+
+bool DdsContext::wait_for_matching_change(std::uint64_t seen, std::chrono::milliseconds timeout) {
+    std::unique_lock lock(arrival_mutex_);
+    return matching_.wait_for(lock, timeout, [&] { return matching_changes_ != seen; });
 }
 
 std::vector<std::string> DdsContext::wait_received(const std::map<std::string, std::uint64_t>& expected,

@@ -106,10 +106,13 @@ void LockstepMaster::wait_in_process_matched(const Remote& remote,
                                              const std::function<void(const std::string&)>& check_startup) {
     // As a follower process before its hello: a reader no one writes is a
     // configuration error, reported with the node's name when the bound passes.
-    for (ReaderBase* reader : remote.in_process_dds->readers()) {
-        while (reader->matched_writers() < 1) {
+    DdsContext& node_dds = *remote.in_process_dds;
+    for (ReaderBase* reader : node_dds.readers()) {
+        for (;;) {
+            const std::uint64_t seen = node_dds.matching_change_count();
+            if (reader->matched_writers() >= 1) break;
             check_startup("node '" + remote.name + "': a writer for the topic it reads, " + reader->topic_name());
-            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+            node_dds.wait_for_matching_change(seen, kPollSlice);
         }
     }
 }
@@ -144,9 +147,12 @@ void LockstepMaster::start() {
 
     if (!remotes_.empty()) {
         const int expected = static_cast<int>(process_remote_count());
-        while (tick_writer_->matched_readers() < expected || ack_reader_->matched_writers() < expected) {
+        for (;;) {
+            // Read before the check: a match in between is then a change seen.
+            const std::uint64_t seen = dds_.matching_change_count();
+            if (tick_writer_->matched_readers() >= expected && ack_reader_->matched_writers() >= expected) break;
             check_startup("DDS discovery of the clock topics");
-            ack_reader_->wait_for_data(kPollSlice);
+            dds_.wait_for_matching_change(seen, kPollSlice);
         }
         for (const Remote& remote : remotes_) {
             if (remote.in_process != nullptr) wait_in_process_matched(remote, check_startup);
@@ -172,10 +178,12 @@ void LockstepMaster::start() {
             expected += static_cast<int>(std::count(remote.subscribed_topics.begin(), remote.subscribed_topics.end(),
                                                     writer->topic_name()));
         }
-        while (writer->matched_readers() < expected) {
+        for (;;) {
+            const std::uint64_t seen = dds_.matching_change_count();
+            if (writer->matched_readers() >= expected) break;
             check_startup("matching of topic " + writer->topic_name() + " (" +
                           std::to_string(writer->matched_readers()) + "/" + std::to_string(expected) + " readers)");
-            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+            dds_.wait_for_matching_change(seen, kPollSlice);
         }
     }
     // And every local reader must be reached by every writer of its topic: ours
@@ -189,10 +197,12 @@ void LockstepMaster::start() {
             expected += static_cast<int>(std::count(remote.published_topics.begin(), remote.published_topics.end(),
                                                     reader->topic_name()));
         }
-        while (reader->matched_writers() < expected) {
+        for (;;) {
+            const std::uint64_t seen = dds_.matching_change_count();
+            if (reader->matched_writers() >= expected) break;
             check_startup("matching of topic " + reader->topic_name() + " (" +
                           std::to_string(reader->matched_writers()) + "/" + std::to_string(expected) + " writers)");
-            ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+            dds_.wait_for_matching_change(seen, kPollSlice);
         }
     }
     for (Local& local : locals_) local.node->activate(0);
@@ -368,7 +378,9 @@ std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq,
         for (WriterBase* writer : node_dds.writers()) {
             const auto it = readers.find(writer->topic_name());
             if (it == readers.end()) continue;
-            while (static_cast<std::uint64_t>(writer->matched_readers()) < it->second) {
+            for (;;) {
+                const std::uint64_t seen = node_dds.matching_change_count();
+                if (static_cast<std::uint64_t>(writer->matched_readers()) >= it->second) break;
                 if (watchdog_) watchdog_();
                 if (matching.elapsed() > timeouts_.startup) {
                     throw NodeFailure(FailureKind::startup_timeout, remote.name,
@@ -377,7 +389,7 @@ std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq,
                                           std::to_string(it->second) + " readers within " +
                                           std::to_string(timeouts_.startup.count()) + " ms");
                 }
-                ack_reader_->wait_for_data(std::chrono::milliseconds(5));
+                node_dds.wait_for_matching_change(seen, kPollSlice);
             }
         }
     }
@@ -491,6 +503,7 @@ bool FollowerLink::wait_matched() {
     // the first tick's reader counts then say whom each writer must reach.
     const WallStopwatch startup;
     for (;;) {
+        const std::uint64_t seen = dds_.matching_change_count();
         std::vector<std::string> unmatched;
         for (ReaderBase* reader : dds_.readers()) {
             if (reader->matched_writers() < 1) unmatched.push_back("reads " + reader->topic_name());
@@ -505,7 +518,7 @@ bool FollowerLink::wait_matched() {
                       << " ms for: " << list << "\n";
             return false;
         }
-        tick_reader_->wait_for_data(std::chrono::milliseconds(5));
+        dds_.wait_for_matching_change(seen, kPollSlice);
     }
 }
 
@@ -577,6 +590,7 @@ std::string FollowerLink::wait_writers_reach_readers(const msg::ClockTick& first
     const TopicCounts readers = read_counts(first_tick.reader_counts());
     const WallStopwatch waited;
     for (;;) {
+        const std::uint64_t seen = dds_.matching_change_count();
         std::vector<std::string> short_topics;
         for (WriterBase* writer : dds_.writers()) {
             const auto it = readers.find(writer->topic_name());
@@ -591,7 +605,7 @@ std::string FollowerLink::wait_writers_reach_readers(const msg::ClockTick& first
             return "writers did not reach every reader within " + std::to_string(options_.startup_timeout.count()) +
                    " ms: " + join(short_topics);
         }
-        tick_reader_->wait_for_data(std::chrono::milliseconds(5));
+        dds_.wait_for_matching_change(seen, kPollSlice);
     }
 }
 
