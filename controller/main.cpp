@@ -67,7 +67,9 @@ int main(int argc, char** argv) {
         if (stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(stall_at_s);
         // TEST-ONLY fault (the catalogue of faulty controllers): the same stall from the case file.
         if (config.faults.stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(config.faults.stall_at_s);
-        rig::DdsContext dds(domain_id, node_name);
+        rig::DdsContext dds(domain_id, node_name, /*watch_discovery=*/false,
+                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
+                                                     : rig::ReliabilityTimers::few_wakeups);
         if (wired_mode) {
             if (clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
             if (modbus_rtu_device.empty() == modbus_tcp.empty()) {

@@ -45,7 +45,7 @@ int run_emulate_gnss(const EmulateGnssOptions& options, std::ostream& out, std::
         }
 
         const DomainLease lease = DomainLease::acquire();
-        DdsContext dds(lease.domain_id(), "emulate-gnss");
+        DdsContext dds(lease.domain_id(), "emulate-gnss", /*watch_discovery=*/false, ReliabilityTimers::prompt_repair);
         emulators::GnssG970 gnss(world.plant, world.gnss);
         NmeaSerialAdapter adapter(*port);
         RealtimeMaster master(dds, LockstepTimeouts{});

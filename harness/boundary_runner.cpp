@@ -98,7 +98,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
         const BoundaryCaseSpec& boundary = *spec.boundary;
         const BoundaryWorld world(boundary, seed);
         CaseSession session(spec, case_dir, options.domain, options.open_hid);
-        DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
+        DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true, reliability_timers_for(spec.mode));
         session.start_controller(spec, options.controller_executable.parent_path() / kBoundaryControllerExecutable, case_dir,
                                  dds_security_environment(options.dds_security_dir, kControllerIdentity));
         TraceRecorder trace(dds, trace_file);

@@ -488,7 +488,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         CaseSession session(spec, case_dir, options.domain, options.open_hid);
         // The harness's participant first, watching discovery; then the
         // controller, so every endpoint it makes is seen.
-        DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true);
+        DdsContext dds(session.domain_id(), "harness", /*watch_discovery=*/true, reliability_timers_for(spec.mode));
         const ControllerPlacement placement = place_controller(spec, options);
         std::string in_process_refused = placement.refused;
         if (placement.plugin) in_process_refused = session.start_in_process_controller(spec, *placement.plugin, case_dir, dds);

@@ -10,6 +10,10 @@
 // change's sequence number sends add_gaps_for_holes_in_history_ counting towards
 // 2^64 with the writer's mutex held, and the destructor waits on that mutex for
 // ever (seen as a hung `rig run` after a controller crashed mid-case).
+//
+// And the start-up's waits and the reliability timers: matches and unmatches
+// wake wait_for_matching_change on both sides; each context's endpoints get
+// its ReliabilityTimers, and a camera frame's get prompt repair.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -25,6 +29,7 @@
 #include <future>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "idl/topics.h"
 #include "rig/host/domain_lease.h"
@@ -86,6 +91,50 @@ TEST(DdsContext, MatchingChangesWakeTheWaiterOnBothSides) {
     reader.reset();
     EXPECT_TRUE(wait_until(writer_side, before_unmatch, [&] { return writer.matched_readers() == 0; }));
     EXPECT_GT(writer_side.matching_change_count(), before_unmatch);
+}
+
+// The reliability timers follow the context (rig/runtime/dds_context.h):
+// lockstep's few wake-ups, real time's prompt repair, and prompt repair for a
+// large type (a camera frame) whatever the context says.
+TEST(DdsContext, ReliabilityTimersFollowTheContextAndLargeTypesRepairPromptly) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    rig::DdsContext lockstep(lease.domain_id(), "timers-lockstep");
+    rig::DdsContext realtime(lease.domain_id(), "timers-realtime", /*watch_discovery=*/false,
+                             rig::ReliabilityTimers::prompt_repair);
+    EXPECT_EQ(lockstep.reliability_timers(), rig::ReliabilityTimers::few_wakeups);
+    rig::Writer<rig::msg::NmeaSentence> lockstep_writer(lockstep, rig::topics::kDdsCheckPing);
+    rig::Reader<rig::msg::NmeaSentence> lockstep_reader(lockstep, rig::topics::kDdsCheckPing);
+    rig::Writer<rig::msg::CameraFrame> frame_writer(lockstep, rig::topics::kCameraLeftFrame);
+    rig::Writer<rig::msg::NmeaSentence> realtime_writer(realtime, rig::topics::kDdsCheckPing);
+    rig::Reader<rig::msg::NmeaSentence> realtime_reader(realtime, rig::topics::kDdsCheckPing);
+
+    const auto writer_times = [](rig::DdsContext& dds, const std::string& topic) {
+        std::vector<eprosima::fastdds::dds::DataWriter*> writers;
+        dds.publisher().get_datawriters(writers);
+        for (auto* writer : writers) {
+            if (writer->get_topic()->get_name() == topic) return writer->get_qos().reliable_writer_qos().times;
+        }
+        ADD_FAILURE() << "no writer on " << topic;
+        return eprosima::fastrtps::rtps::WriterTimes{};
+    };
+    const auto response_delay = [](rig::DdsContext& dds) {
+        std::vector<eprosima::fastdds::dds::DataReader*> readers;
+        dds.subscriber().get_datareaders(readers);
+        EXPECT_EQ(readers.size(), 1u);
+        return readers.empty() ? eprosima::fastrtps::Duration_t() :
+                                 readers.front()->get_qos().reliable_reader_qos().times.heartbeatResponseDelay;
+    };
+    using eprosima::fastrtps::Duration_t;
+    const auto few = writer_times(lockstep, rig::topics::kDdsCheckPing);
+    EXPECT_EQ(few.heartbeatPeriod, Duration_t(0, 10'000'000));
+    EXPECT_EQ(few.nackSupressionDuration, Duration_t(0, 5'000'000));
+    EXPECT_EQ(response_delay(lockstep), Duration_t(0, 2'000'000));
+    for (const auto& prompt : {writer_times(realtime, rig::topics::kDdsCheckPing),
+                               writer_times(lockstep, rig::topics::kCameraLeftFrame)}) {
+        EXPECT_EQ(prompt.heartbeatPeriod, Duration_t(0, 200'000));
+        EXPECT_EQ(prompt.nackSupressionDuration, Duration_t(0, 0));
+    }
+    EXPECT_EQ(response_delay(realtime), Duration_t(0, 0));
 }
 
 TEST(DdsContext, EndpointsDestroyedFirstLeaveTheRegistry) {

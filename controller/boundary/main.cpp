@@ -42,7 +42,9 @@ int main(int argc, char** argv) {
         if (wired && clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
         // The context first: the node's readers and writers unregister from it
         // when the node is destroyed, so it must outlive the node.
-        rig::DdsContext dds(domain_id, node_name);
+        rig::DdsContext dds(domain_id, node_name, /*watch_discovery=*/false,
+                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
+                                                     : rig::ReliabilityTimers::few_wakeups);
         rig::controller::boundary::BoundaryControllerNode controller(
             node_name, rig::controller::boundary::load_boundary_node_config(config_file), serial);
         rig::FollowerOptions options;

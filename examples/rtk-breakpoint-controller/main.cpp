@@ -168,7 +168,9 @@ int main(int argc, char** argv) {
     try {
         // The context before the node: the node's readers and writers leave the
         // context when the node is destroyed, so the context must outlive it.
-        rig::DdsContext dds(domain, node_name);
+        rig::DdsContext dds(domain, node_name, /*watch_discovery=*/false,
+                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
+                                                     : rig::ReliabilityTimers::few_wakeups);
         RtkBreakpointController controller(node_name, setting(config, "antenna_to_nozzle_m").value_or(1.63));
         rig::FollowerOptions options;
         options.node_name = node_name;

@@ -22,36 +22,53 @@ namespace {
 // tick (counted delivery, rig/runtime/lockstep.h). Volatile: endpoints are
 // matched before the first tick (see rig/runtime/lockstep.cpp).
 //
-// The reliability timers are Fast DDS's event thread's work, and on a 2-core
-// machine each wake-up of that thread is a context switch inside the lockstep
-// round. No round waits for an acknowledgement any more (counted delivery
-// replaced wait_for_acknowledgments; only a follower's last ack and the
-// ping-pong's end still wait for one), so the timers are set for few wake-ups:
-// - nackSupressionDuration: Fast DDS 2.9 arms this timer for each sample it
-//   sends to a reliable remote reader and wakes the event thread when it is not
-//   already armed. At 0 it expired at once, so every write woke the event
-//   thread (3.4 wake-ups a round in the harness, 2.1 in the controller, counted
-//   with perf's sched_wakeup on a fusion case). At 5 ms the writes of a round
-//   and of the rounds after it find it armed.
-// - heartbeatPeriod 10 ms (was 0.2 ms, when every round waited for acks): a
+// The reliability timers (ReliabilityTimers, dds_context.h) are Fast DDS's
+// event thread's work; on a 2-core machine each wake-up of that thread is a
+// context switch inside the lockstep round. No lockstep round waits for an
+// acknowledgement (counted delivery replaced wait_for_acknowledgments; a
+// follower's last ack, the ping-pong's end, `rig dds-check`'s echo and
+// vision_bench's frames still wait for one), so `few_wakeups` sets:
+// - nackSupressionDuration 5 ms: Fast DDS 2.9 arms this timer for each sample
+//   it sends to a reliable remote reader (the sample is UNDERWAY until it
+//   fires) and wakes the event thread when it is not already armed. At 0 it
+//   expired at once, so every write woke the event thread (3.4 wake-ups a round
+//   in the harness, 2.1 in the controller, counted with perf's sched_wakeup on
+//   a fusion case). At 5 ms the writes of a round and of the rounds after it
+//   find it armed.
+// - heartbeatPeriod 10 ms (0.2 ms before, when every round waited for acks): a
 //   heartbeat, and the reader's acknack in answer, every 10 ms while samples are
-//   unacknowledged, not every round. Keep-all histories then hold about 10 ms
-//   of samples, far under max_samples. 100 ms and 1 s measured no faster.
-// - heartbeatResponseDelay 2 ms (reader side, below): heartbeats arriving
-//   within 2 ms are answered by one acknack.
-// A sample lost on UDP (SHM does not lose them) is repaired after the next
-// heartbeat, within about 10 ms; in lockstep that is a slower round, never a
-// different trace. `rig bench` before / after, same run: process mode 169.9 ->
-// 100.4 us a round, the ping-pong floor 97.7 -> 63.8 us (README "Speed").
-dds::DataWriterQos project_writer_qos(dds::Publisher& publisher) {
+//   unacknowledged, not every round. 100 ms and 1 s measured no faster.
+// - heartbeatResponseDelay 2 ms (reader side): heartbeats arriving within 2 ms
+//   are answered by one acknack.
+// A sample waits out the suppression before a heartbeat announces it, so an
+// acknowledgement, and the repair of a lost sample, take up to about 17 ms
+// (5 + 10 + 2), and keep-all histories hold that long of samples (far under
+// max_samples). Samples are lost when a UDP datagram is, or when a
+// shared-memory port or segment is full; in lockstep a loss is a slower round,
+// never a different trace. `rig bench` before / after, same run: process mode
+// 169.9 -> 100.4 us a round, the ping-pong floor 97.7 -> 63.8 us (README
+// "Speed").
+//
+// `prompt_repair` keeps the timers the project had before (heartbeat 0.2 ms,
+// no suppression, an immediate acknack): real-time runs, where a device
+// sample repaired 17 ms late is a late sample, and large types (camera frames:
+// each spans several shared-memory buffers, a full segment drops fragments,
+// and a frame a writer sends a few times a second costs nothing to wake for).
+dds::DataWriterQos project_writer_qos(dds::Publisher& publisher, ReliabilityTimers timers) {
     dds::DataWriterQos qos = publisher.get_default_datawriter_qos();
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
     qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-    qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 10'000'000);
-    qos.reliable_writer_qos().times.initialHeartbeatDelay = eprosima::fastrtps::Duration_t(0, 1'000'000);
-    qos.reliable_writer_qos().times.nackResponseDelay = eprosima::fastrtps::Duration_t(0, 0);
-    qos.reliable_writer_qos().times.nackSupressionDuration = eprosima::fastrtps::Duration_t(0, 5'000'000);
+    auto& times = qos.reliable_writer_qos().times;
+    times.initialHeartbeatDelay = eprosima::fastrtps::Duration_t(0, 1'000'000);
+    times.nackResponseDelay = eprosima::fastrtps::Duration_t(0, 0);
+    if (timers == ReliabilityTimers::few_wakeups) {
+        times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 10'000'000);
+        times.nackSupressionDuration = eprosima::fastrtps::Duration_t(0, 5'000'000);
+    } else {
+        times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200'000);
+        times.nackSupressionDuration = eprosima::fastrtps::Duration_t(0, 0);
+    }
     qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
     qos.data_sharing().off();
     return qos;
@@ -79,19 +96,20 @@ std::uint32_t max_serialized_size(dds::DomainParticipant& participant, const dds
 // pair) at the same cost per frame. DYNAMIC_REUSABLE_MEMORY_MODE was measured
 // too: 32 MB, but 2.2 ms of CPU a frame instead of 0.16 ms in process (each
 // payload allocated and faulted in anew), so the preallocating policy stays.
-// Reliability, keep-all, max_samples and thus the lockstep guarantee (a tick is
-// acknowledged once every sample is in every reader's history) are untouched.
+// Reliability, keep-all, max_samples and thus counted delivery are untouched.
 template <class Qos>
 void apply_large_type_memory(Qos& qos) {
     qos.resource_limits().allocated_samples = 1;
 }
 
-dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber) {
+dds::DataReaderQos project_reader_qos(dds::Subscriber& subscriber, ReliabilityTimers timers) {
     dds::DataReaderQos qos = subscriber.get_default_datareader_qos();
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     qos.history().kind = dds::KEEP_ALL_HISTORY_QOS;
     qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
-    qos.reliable_reader_qos().times.heartbeatResponseDelay = eprosima::fastrtps::Duration_t(0, 2'000'000);
+    qos.reliable_reader_qos().times.heartbeatResponseDelay =
+        timers == ReliabilityTimers::few_wakeups ? eprosima::fastrtps::Duration_t(0, 2'000'000)
+                                                 : eprosima::fastrtps::Duration_t(0, 0);
     qos.data_sharing().off();
     return qos;
 }
@@ -117,8 +135,11 @@ void delete_writer(dds::Publisher& publisher, dds::DataWriter* writer) {
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
     : context_(&context), topic_name_(std::move(topic_name)), listener_(context), counts_as_output_(counts_as_output) {
-    dds::DataWriterQos qos = project_writer_qos(context_->publisher());
-    if (const std::uint32_t bound = max_serialized_size(context_->participant(), *topic); bound > kLargeTypeBytes) {
+    const std::uint32_t bound = max_serialized_size(context_->participant(), *topic);
+    const bool large = bound > kLargeTypeBytes;
+    dds::DataWriterQos qos =
+        project_writer_qos(context_->publisher(), large ? ReliabilityTimers::prompt_repair : context_->reliability_timers());
+    if (large) {
         apply_large_type_memory(qos);
         max_serialized_bytes_ = bound;
     }
@@ -184,8 +205,10 @@ void WriterBase::MatchListener::on_publication_matched(dds::DataWriter*, const d
 
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
     : context_(&context), topic_name_(std::move(topic_name)), listener_(context) {
-    dds::DataReaderQos qos = project_reader_qos(context_->subscriber());
-    if (max_serialized_size(context_->participant(), *topic) > kLargeTypeBytes) apply_large_type_memory(qos);
+    const bool large = max_serialized_size(context_->participant(), *topic) > kLargeTypeBytes;
+    dds::DataReaderQos qos =
+        project_reader_qos(context_->subscriber(), large ? ReliabilityTimers::prompt_repair : context_->reliability_timers());
+    if (large) apply_large_type_memory(qos);
     reader_ = context_->subscriber().create_datareader(
         topic, qos, &listener_, dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
     if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
@@ -298,8 +321,9 @@ public:
     std::vector<std::string> refused;  // GUID prefixes whose authentication failed
 };
 
-DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery)
-    : domain_id_(domain_id) {
+DdsContext::DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery,
+                       ReliabilityTimers timers)
+    : domain_id_(domain_id), timers_(timers) {
     if (watch_discovery) discovery_ = std::make_unique<DiscoveryWatch>();
     participant_ = create_loopback_participant(domain_id, participant_name, discovery_.get());
     guid_prefix_ = prefix_of(participant_->guid().guidPrefix);

@@ -1,8 +1,9 @@
 #pragma once
 // One process's DDS entities: a participant from the loopback profile, one
 // publisher, one subscriber, and typed Writer<Msg> / Reader<Msg> endpoints whose
-// QoS the whole project shares (reliable, keep-all, volatile): lockstep time
-// needs every sample delivered before a tick is acknowledged.
+// QoS the whole project shares (reliable, keep-all, volatile): a lockstep node
+// steps only once its readers hold every sample the tick counts, so nothing
+// written may be lost.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -32,6 +33,19 @@ namespace rig {
 namespace dds = eprosima::fastdds::dds;
 
 class DdsContext;
+
+// Fast DDS's reliability timers for a context's endpoints: how soon a lost
+// sample is repaired, against how often Fast DDS's event thread is woken
+// (the values and measurements: rig/runtime/dds_context.cpp).
+enum class ReliabilityTimers {
+    // Lockstep: lost samples are rare (SHM) and cost a slower round, never a
+    // different trace; waking the event thread for every write cost process
+    // mode 40 % of its round.
+    few_wakeups,
+    // Real time: a lost sample repaired within about a millisecond, as a
+    // 100 Hz device needs; its few writes a second make the wake-ups cheap.
+    prompt_repair,
+};
 
 // An endpoint of another participant on the domain, as discovery reported it
 // (rig/runtime/dds_context.cpp). The harness judges roles from these, not from what a
@@ -177,12 +191,16 @@ class DdsContext {
 public:
     // `watch_discovery`: keep every endpoint other participants create or remove
     // on the domain, for take_discoveries() (the harness's role check).
-    DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery = false);
+    DdsContext(std::uint32_t domain_id, const std::string& participant_name, bool watch_discovery = false,
+               ReliabilityTimers timers = ReliabilityTimers::few_wakeups);
     ~DdsContext();
     DdsContext(const DdsContext&) = delete;
     DdsContext& operator=(const DdsContext&) = delete;
 
     std::uint32_t domain_id() const { return domain_id_; }
+    // The timers every endpoint made in this context gets (a large type gets
+    // prompt_repair whatever this says).
+    ReliabilityTimers reliability_timers() const { return timers_; }
     // This participant's GUID prefix (hex), as Reader::take_all_with_writer reports writers.
     const std::string& guid_prefix() const { return guid_prefix_; }
     // Whether a participant is the rig's own: its GUID prefix is of this process
@@ -265,6 +283,7 @@ private:
 
     class DiscoveryWatch;
     std::uint32_t domain_id_;
+    ReliabilityTimers timers_;
     std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
     std::string guid_prefix_;
     bool secured_ = false;  // created with a DDS-Security identity (rig/runtime/dds_security.h)
