@@ -14,6 +14,7 @@
 #include "harness/realtime_case_loop.h"
 #include "harness/run_interrupt.h"
 #include "harness/trace_recorder.h"
+#include "rig/host/cpu_lease.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/wire/wire_adapters.h"
 
@@ -214,6 +215,7 @@ CaseRun run_boundary_case(const CaseSpec& spec, std::uint64_t seed, const std::s
                                                         {"controller_mode", session.controller_mode()},
                                                         {"startup_wall_seconds", startup_wall_s}};
         run_facts["in_process_refused"] = asked_in_process ? "seed 001's boundary controller has no plugin" : "";
+        run_facts["cpu_placement"] = describe_thread_placement();  // rig/host/cpu_lease.h
         run_facts["plant_rejected_duty_commands"] = plant.rejected_commands();
         nlohmann::json report_frames = nlohmann::json::array();
         for (std::size_t c = 0; c < cameras.size(); ++c) {

@@ -7,6 +7,7 @@
 #include "harness/sha256.h"
 #include "idl/topics.h"
 #include "rig/camera/png_file.h"
+#include "rig/host/cpu_lease.h"
 #include "rig/runtime/realtime.h"
 
 namespace rig::harness {
@@ -208,9 +209,6 @@ TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
 }
 
 CameraNode::Rendered CameraNode::render(std::uint64_t k) const {
-    // On the rendering thread, which the real-time loop may have started at its
-    // own SCHED_FIFO priority: rendering must not take a core from the loop.
-    drop_to_time_sharing();
     // Two frames may be in flight: one renders at a time. Which comes first
     // does not matter: the crop truth is the same whatever is looked at first.
     const std::lock_guard<std::mutex> one_at_a_time(render_mutex_);
@@ -248,7 +246,15 @@ TimeNs CameraNode::step(TimeNs now_ns) {
         // The frame rendered ahead (an exception there comes out here), or now.
         // Keep the next frames rendering (an exception there comes out at its get()).
         for (std::uint64_t k = ahead_.empty() ? frame_count_ : ahead_.back().first + 1; k <= frame_count_ + kRenderAhead; ++k) {
-            ahead_.emplace_back(k, std::async(std::launch::async, [this, k] { return render(k); }));
+            ahead_.emplace_back(k, std::async(std::launch::async, [this, k] {
+                // A thread of its own, started by the loop's: at the real-time
+                // loop's SCHED_FIFO priority, or on a lockstep case's leased CPU
+                // (rig/host/cpu_lease.h). Rendering runs beside the loop, on any
+                // CPU, below it: it must not take the loop's core.
+                drop_to_time_sharing();
+                leave_leased_cpu();
+                return render(k);
+            }));
         }
         if (ahead_.front().first != frame_count_) throw std::logic_error(name_ + ": frames rendered out of order");
         Rendered rendered = ahead_.front().second.get();

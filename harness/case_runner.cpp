@@ -30,6 +30,7 @@
 #include "harness/trace_recorder.h"
 #include "harness/wire_fault_report.h"
 #include "idl/topics.h"
+#include "rig/host/cpu_lease.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/runtime/realtime.h"
 #include "rig/wire/wire_adapters.h"
@@ -103,6 +104,7 @@ struct RunFacts {
     std::uint64_t rounds = 0;
     double stepping_wall_seconds = 0.0;
     std::string realtime_scheduling;
+    std::string cpu_placement = describe_thread_placement();  // rig/host/cpu_lease.h
     std::vector<EmissionJitter> emission_jitter;
     nlohmann::json lateness;  // real time: lateness_json(), null in lockstep
     std::optional<BoardAttachment> board_attachment;  // controller: external
@@ -369,6 +371,7 @@ nlohmann::json run_facts_json(const RunFacts& facts, double wall_seconds) {
                           {"rounds", facts.rounds},
                           {"stepping_wall_seconds", facts.stepping_wall_seconds},
                           {"realtime_scheduling", facts.realtime_scheduling},
+                          {"cpu_placement", facts.cpu_placement},
                           {"emission_jitter", std::move(jitter)}};
     if (!facts.board_io.is_null()) run["board_io"] = facts.board_io;
     if (!facts.lateness.is_null()) run["lateness"] = facts.lateness;
@@ -475,6 +478,9 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 }
 
 CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options) {
+    // A lockstep case's chain of hand-offs (this thread, Fast DDS's threads, the
+    // controller process) on one CPU; a real-time case keeps the scheduler's.
+    const CpuLease cpu(options.pin_cpu && spec.mode == RunMode::lockstep);
     if (spec.system == CaseSystem::boundary) return run_boundary_case(spec, seed, run_name, options);
     const WallStopwatch wall;
     const std::filesystem::path case_dir = options.out_dir / "cases" / run_name;

@@ -43,6 +43,10 @@ struct RunOptions {
     // `rig run --in-process`: every case whose controller can runs in process
     // (a case's own controller.in_process wins).
     bool in_process = false;
+    // Each lockstep case's thread, the controller process it starts and Fast
+    // DDS's threads on one leased CPU at SCHED_BATCH (rig/host/cpu_lease.h);
+    // `--no-pin`: left to the scheduler (a controller that steps on several threads).
+    bool pin_cpu = true;
     // `rig sweep --seeds N`: every case runs once per seed here, as NAME-seedN
     // (a case's own seed or `seeds:` and --seed are then not used).
     std::vector<std::uint64_t> seed_sweep;

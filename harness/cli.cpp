@@ -1,7 +1,7 @@
 // `rig`: the rig's one command line (README "Running cases", `rig --help`).
 //   rig --version
-//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N] [--quiet | --verbose]
-//   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N] [--in-process]
+//   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N] [--no-pin] [--quiet | --verbose]
+//   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N] [--in-process] [--no-pin]
 //   rig bench CASE... [--repeat N] [--pingpong-rounds N] [--dds-security] [--out DIR]
 //   rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]
 //   rig nmea decode FILE|-
@@ -442,6 +442,10 @@ int main(int argc, char** argv) {
     run->add_flag("--in-process", run_options.in_process,
                   "software-in-the-loop: run each lockstep case's controller from its plugin inside the rig's process "
                   "(a case's controller.in_process wins; others run as processes, saying why)");
+    constexpr const char* kNoPinHelp =
+        "leave each lockstep case's threads and its controller process to the scheduler instead of one leased CPU "
+        "(README \"Speed\"; for a controller that steps on several threads)";
+    run->add_flag("!--no-pin", run_options.pin_cpu, kNoPinHelp);
     bool run_quiet = false;
     bool run_verbose = false;
     bool run_dds_security = false;
@@ -489,6 +493,7 @@ int main(int argc, char** argv) {
     sweep->add_option("--jobs", sweep_options.jobs, "runs at once, each on its own DDS domain")->check(CLI::Range(1, 16));
     sweep->add_flag("--in-process", sweep_options.in_process,
                     "software-in-the-loop, as rig run --in-process (same digests, several times faster)");
+    sweep->add_flag("!--no-pin", sweep_options.pin_cpu, kNoPinHelp);
     bool sweep_quiet = false;
     sweep->add_flag("--quiet,-q", sweep_quiet, "print only the summary line: no progress, no table");
 

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -16,13 +17,15 @@
 #include "harness/output_dir.h"
 #include "harness/case_spec.h"
 #include "harness/results_writer.h"
+#include "rig/host/cpu_lease.h"
 #include "rig/runtime/dds_security.h"
+#include "rig/runtime/thread_id_cache.h"
 
 namespace rig::harness {
 namespace {
 
 struct ModeRuns {
-    std::string mode;  // process, in_process, process_dds_security
+    std::string mode;  // process (one leased CPU), process_unpinned, in_process, process_dds_security
     std::vector<CaseResult> runs;
     std::vector<int> repeat_of;  // per run: which repeat (0-based) it belongs to
 };
@@ -86,6 +89,43 @@ ModeFigures figures_of(const std::vector<CaseResult>& runs) {
     return f;
 }
 
+// A series of ping-pongs (one before each repeat): medians over them.
+struct FloorFigures {
+    PingPongResult result;
+    std::vector<double> p50s;  // per repeat
+};
+
+FloorFigures floor_figures_of(const std::vector<PingPongResult>& slices, std::uint32_t rounds) {
+    FloorFigures f;
+    std::vector<double> p99s, means, matched;
+    for (const PingPongResult& slice : slices) {
+        f.p50s.push_back(slice.p50_us);
+        p99s.push_back(slice.p99_us);
+        means.push_back(slice.mean_us);
+        matched.push_back(slice.matched_after_s);
+    }
+    f.result.rounds = rounds;
+    f.result.p50_us = percentile(f.p50s, 0.5);
+    f.result.p99_us = percentile(p99s, 0.5);
+    f.result.mean_us = percentile(means, 0.5);
+    f.result.matched_after_s = percentile(matched, 0.5);
+    return f;
+}
+
+// Each repeat's us/round over the ping-pong measured just before it; the median of those.
+double median_ratio_to_floor(const ModeRuns& mode, const std::vector<PingPongResult>& floors) {
+    std::vector<double> ratios;
+    for (std::size_t r = 0; r < floors.size(); ++r) {
+        std::vector<CaseResult> runs_of_repeat;
+        for (std::size_t i = 0; i < mode.runs.size(); ++i) {
+            if (mode.repeat_of[i] == static_cast<int>(r)) runs_of_repeat.push_back(mode.runs[i]);
+        }
+        if (runs_of_repeat.empty() || floors[r].p50_us <= 0.0) continue;
+        ratios.push_back(figures_of(runs_of_repeat).us_per_round / floors[r].p50_us);
+    }
+    return percentile(ratios, 0.5);
+}
+
 std::string load_average() {
     std::ifstream in("/proc/loadavg");
     std::string one, five, fifteen;
@@ -144,14 +184,23 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     // on this 2-core machine the ping-pong alone moved between 57 and 81 us a
     // round trip from one invocation to the next (where the scheduler put the
     // two processes' threads), more than the rig's own cost moved, so a single
-    // floor made the ratio a draw.
-    std::vector<PingPongResult> floors;
+    // floor made the ratio a draw. It is measured twice, in the two placements
+    // process mode runs in (rig/host/cpu_lease.h): the ping-pong's threads and
+    // its second process on one leased CPU at SCHED_BATCH, as a lockstep case
+    // runs by default, and left to the scheduler, as with `rig run --no-pin`.
+    // Each process-mode row is judged against the floor of its own placement.
+    std::vector<PingPongResult> floors_pinned, floors_free;
     std::optional<PingPongResult> secured_floor;
+    auto measure_floor = [&](bool pin) {
+        const CpuLease cpu(pin);
+        return run_dds_pingpong(options.pingpong);
+    };
     try {
         if (credentials) {
             const RigIdentityScope rig_identity(credentials);
             PingPongOptions secured = options.pingpong;
             secured.pong_environment = dds_security_environment(credentials->dir, kRigIdentity);
+            const CpuLease cpu(true);
             secured_floor = run_dds_pingpong(secured);
         }
     } catch (const std::exception& error) {
@@ -160,14 +209,19 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     }
 
     bool failed = false;
-    std::vector<ModeRuns> modes = {{"process", {}, {}}, {"in_process", {}, {}}};
+    // process: on one leased CPU (the default); process_unpinned: --no-pin.
+    std::vector<ModeRuns> modes = {{"process", {}, {}}, {"process_unpinned", {}, {}}, {"in_process", {}, {}}};
     if (credentials) modes.push_back({"process_dds_security", {}, {}});
-    std::map<std::string, std::set<std::string>> digests;  // case -> digests seen in every run of both modes
+    std::map<std::string, std::set<std::string>> digests;  // case -> digests seen in every run of every mode
     for (ModeRuns& mode : modes) {
         for (int r = 0; r < options.repeat; ++r) {
-            if (mode.mode == "process") {
+            if (mode.mode == "process" || mode.mode == "process_unpinned") {
                 try {
-                    floors.push_back(run_dds_pingpong(options.pingpong));
+                    if (mode.mode == "process") {
+                        floors_pinned.push_back(measure_floor(true));
+                    } else {
+                        floors_free.push_back(measure_floor(false));
+                    }
                 } catch (const std::exception& error) {
                     err << "rig bench: " << error.what() << "\n";
                     return 1;
@@ -177,6 +231,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 RunOptions run_options = options.run;
                 run_options.jobs = 1;
                 run_options.in_process = mode.mode == "in_process";
+                run_options.pin_cpu = mode.mode != "process_unpinned";
                 run_options.out_dir = options.out_dir / mode.mode / std::to_string(r);
                 const bool secured = mode.mode == "process_dds_security";
                 if (secured) run_options.dds_security_dir = credentials->dir;
@@ -184,7 +239,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 const std::vector<CaseInstance> instances = expand_runs({spec}, run_options);
                 const CaseRun run = run_case(spec, instances.front().seed, instances.front().name, run_options);
                 const CaseResult& result = run.result;
-                const std::string expected_mode = secured ? "process" : mode.mode;
+                const std::string expected_mode = mode.mode == "in_process" ? "in_process" : "process";
                 if (!result.error.empty() || result.controller_mode != expected_mode) {
                     err << "rig bench: " << result.name << " (" << mode.mode << ", run " << r + 1 << "): "
                         << (result.error.empty() ? "ran as " + result.controller_mode : result.error) << "\n";
@@ -206,37 +261,12 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     }
 
     const ModeFigures process = figures_of(modes[0].runs);
-    const ModeFigures in_process = figures_of(modes[1].runs);
-    // The floor row: medians over the repeats' ping-pongs.
-    PingPongResult floor;
-    std::vector<double> floor_p50s;
-    {
-        std::vector<double> p99s, means, matched;
-        for (const PingPongResult& slice : floors) {
-            floor_p50s.push_back(slice.p50_us);
-            p99s.push_back(slice.p99_us);
-            means.push_back(slice.mean_us);
-            matched.push_back(slice.matched_after_s);
-        }
-        floor.rounds = options.pingpong.rounds;
-        floor.p50_us = percentile(floor_p50s, 0.5);
-        floor.p99_us = percentile(p99s, 0.5);
-        floor.mean_us = percentile(means, 0.5);
-        floor.matched_after_s = percentile(matched, 0.5);
-    }
-    const double floor_us = floor.p50_us;
-    // Process mode against the floor: each repeat's us/round over the ping-pong
-    // measured just before it; the median of those.
-    std::vector<double> process_ratios;
-    for (std::size_t r = 0; r < floors.size(); ++r) {
-        std::vector<CaseResult> runs_of_repeat;
-        for (std::size_t i = 0; i < modes[0].runs.size(); ++i) {
-            if (modes[0].repeat_of[i] == static_cast<int>(r)) runs_of_repeat.push_back(modes[0].runs[i]);
-        }
-        if (runs_of_repeat.empty() || floors[r].p50_us <= 0.0) continue;
-        process_ratios.push_back(figures_of(runs_of_repeat).us_per_round / floors[r].p50_us);
-    }
-    const double process_ratio = percentile(process_ratios, 0.5);
+    const ModeFigures process_unpinned = figures_of(modes[1].runs);
+    const ModeFigures in_process = figures_of(modes[2].runs);
+    const FloorFigures pinned_floor = floor_figures_of(floors_pinned, options.pingpong.rounds);
+    const FloorFigures free_floor = floor_figures_of(floors_free, options.pingpong.rounds);
+    const double process_ratio = median_ratio_to_floor(modes[0], floors_pinned);
+    const double process_unpinned_ratio = median_ratio_to_floor(modes[1], floors_free);
     double sim_per_case = 0.0;
     for (const CaseResult& run : modes[0].runs) sim_per_case += run.sim_seconds;
     if (!modes[0].runs.empty()) sim_per_case /= static_cast<double>(modes[0].runs.size());
@@ -246,15 +276,17 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
         << load_average() << " after\n";
     out << "  simulated per case " << fixed(sim_per_case, 1) << " s; " << fixed(process.rounds_per_sim_s, 1)
         << " rounds per simulated second; trace digests "
-        << (digests_equal ? (credentials ? "identical in every run of every mode" : "identical in every run of both modes") : "DIFFER (see above)") << "\n\n";
-    out << "                               us/round  rounds/s  x real time  start-up p50/p99 s  trace KB/sim-min  "
+        << (digests_equal ? "identical in every run of every mode" : "DIFFER (see above)") << "\n\n";
+    out << "                                      us/round  rounds/s  x real time  start-up p50/p99 s  trace KB/sim-min  "
            "vs floor\n";
-    out << "  DDS ping-pong, 2 processes   " << std::setw(8) << fixed(floor.p50_us, 1) << "  " << std::setw(8)
-        << fixed(1e6 / std::max(floor.p50_us, 1e-9), 0) << "  " << std::setw(11) << "-" << "  " << std::setw(18)
-        << (fixed(floor.matched_after_s, 3) + " (match)") << "  " << std::setw(16) << "-" << "  " << std::setw(8)
-        << "1.00" << "   (p99 " << fixed(floor.p99_us, 1) << " us; " << floors.size() << " x " << floor.rounds
-        << " round trips, one before each repeat: p50 " << fixed(percentile(floor_p50s, 0.0), 1) << "-"
-        << fixed(percentile(floor_p50s, 1.0), 1) << " us)\n";
+    auto floor_row = [&](const char* label, const FloorFigures& f) {
+        out << "  " << label << std::setw(8) << fixed(f.result.p50_us, 1) << "  " << std::setw(8)
+            << fixed(1e6 / std::max(f.result.p50_us, 1e-9), 0) << "  " << std::setw(11) << "-" << "  " << std::setw(18)
+            << (fixed(f.result.matched_after_s, 3) + " (match)") << "  " << std::setw(16) << "-" << "  "
+            << std::setw(8) << "1.00" << "   (p99 " << fixed(f.result.p99_us, 1) << " us; " << f.p50s.size() << " x "
+            << f.result.rounds << " round trips, one before each repeat: p50 " << fixed(percentile(f.p50s, 0.0), 1)
+            << "-" << fixed(percentile(f.p50s, 1.0), 1) << " us)\n";
+    };
     auto row = [&](const char* label, const ModeFigures& f, double ratio) {
         out << "  " << label << std::setw(8) << fixed(f.us_per_round, 1) << "  " << std::setw(8)
             << fixed(f.rounds_per_s, 0) << "  " << std::setw(11) << fixed(f.x_real_time, 1) << "  " << std::setw(18)
@@ -262,37 +294,61 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
             << fixed(f.trace_bytes_per_sim_minute / 1024.0, 1) << "  " << std::setw(8)
             << fixed(ratio, 2) << "\n";
     };
-    row("process mode                 ", process, process_ratio);
-    row("in process (SIL)             ", in_process, in_process.us_per_round / std::max(floor_us, 1e-9));
+    floor_row("DDS ping-pong, 2 processes, 1 CPU  ", pinned_floor);
+    row("process mode, 1 CPU (default)      ", process, process_ratio);
+    row("in process (SIL), 1 CPU            ", in_process,
+        in_process.us_per_round / std::max(pinned_floor.result.p50_us, 1e-9));
+    floor_row("DDS ping-pong, 2 processes, any CPU", free_floor);
+    row("process mode, any CPU (--no-pin)   ", process_unpinned, process_unpinned_ratio);
     std::optional<ModeFigures> secured;
     if (credentials) {
-        secured = figures_of(modes[2].runs);
-        out << "  DDS ping-pong, DDS-Security  " << std::setw(8) << fixed(secured_floor->p50_us, 1) << "  "
+        secured = figures_of(modes[3].runs);
+        out << "  DDS ping-pong, DDS-Security, 1 CPU" << std::setw(8) << fixed(secured_floor->p50_us, 1) << "  "
             << std::setw(8) << fixed(1e6 / std::max(secured_floor->p50_us, 1e-9), 0) << "  " << std::setw(11) << "-"
             << "  " << std::setw(18) << (fixed(secured_floor->matched_after_s, 3) + " (match)") << "  "
-            << std::setw(16) << "-" << "  " << std::setw(8) << fixed(secured_floor->p50_us / std::max(floor_us, 1e-9), 2)
-            << "   (p99 " << fixed(secured_floor->p99_us, 1) << " us, " << secured_floor->rounds << " round trips)\n";
-        row("process mode, DDS-Security   ", *secured, secured->us_per_round / std::max(floor_us, 1e-9));
+            << std::setw(16) << "-" << "  " << std::setw(8)
+            << fixed(secured_floor->p50_us / std::max(pinned_floor.result.p50_us, 1e-9), 2) << "   (p99 "
+            << fixed(secured_floor->p99_us, 1) << " us, " << secured_floor->rounds << " round trips)\n";
+        row("process mode, DDS-Security, 1 CPU  ", *secured,
+            secured->us_per_round / std::max(pinned_floor.result.p50_us, 1e-9));
         out << "  DDS-Security costs " << fixed(secured->us_per_round - process.us_per_round, 1)
-            << " us per round in process mode (" << fixed(secured_floor->p50_us - floor_us, 1)
+            << " us per round in process mode (" << fixed(secured_floor->p50_us - pinned_floor.result.p50_us, 1)
             << " us per ping-pong round trip)\n";
     }
     out << "\n  us/round: stepping wall time / rounds (a round: the rig's nodes, a tick to the controller, its "
-           "answer);\n  x real time: simulated / wall per case, start-up included; vs floor: us/round / ping-pong "
-           "p50 (process mode: each repeat\n  over the ping-pong measured just before it, the median of "
-           "those; the other rows over the median ping-pong).\n";
+           "answer);\n  x real time: simulated / wall per case, start-up included; 1 CPU: the case's thread, Fast "
+           "DDS's threads and the\n  controller process on one leased CPU at SCHED_BATCH (rig/host/cpu_lease.h), "
+           "the ping-pong's likewise; vs floor:\n  us/round / the p50 of the ping-pong in the same placement "
+           "(process mode: each repeat over the ping-pong\n  measured just before it, the median of those; SIL over "
+           "the median one-CPU ping-pong).\n";
+    if (process.us_per_round > 0.0 && pinned_floor.result.p50_us > 0.0) {
+        out << "  one CPU against any CPU: process mode " << fixed(process_unpinned.us_per_round / process.us_per_round, 2)
+            << "x as fast a round, the ping-pong " << fixed(free_floor.result.p50_us / pinned_floor.result.p50_us, 2)
+            << "x\n";
+    }
 
+    auto floor_json = [](const FloorFigures& f) {
+        return nlohmann::json{{"rounds", f.result.rounds},
+                              {"p50_us", f.result.p50_us},
+                              {"p99_us", f.result.p99_us},
+                              {"mean_us", f.result.mean_us},
+                              {"matched_after_s", f.result.matched_after_s},
+                              {"p50_us_per_repeat", f.p50s}};
+    };
     nlohmann::json json = {
         {"load_average_before", load_before},
         {"load_average_after", load_average()},
         {"cores", std::thread::hardware_concurrency()},
         {"runs_per_case_and_mode", options.repeat},
         {"digests_identical", digests_equal},
-        {"pingpong", {{"rounds", floor.rounds}, {"p50_us", floor.p50_us}, {"p99_us", floor.p99_us},
-                      {"mean_us", floor.mean_us}, {"matched_after_s", floor.matched_after_s},
-                      {"p50_us_per_repeat", floor_p50s}}},
+        {"thread_id_cache", thread_id_cache_in_use()},
+        {"pingpong", floor_json(pinned_floor)},
+        {"pingpong_unpinned", floor_json(free_floor)},
     };
-    for (const auto& [key, f] : {std::pair{"process", process}, std::pair{"in_process", in_process}}) {
+    for (const auto& [key, f, floor_us] :
+         {std::tuple{"process", process, pinned_floor.result.p50_us},
+          std::tuple{"process_unpinned", process_unpinned, free_floor.result.p50_us},
+          std::tuple{"in_process", in_process, pinned_floor.result.p50_us}}) {
         json[key] = {{"us_per_round", f.us_per_round},
                      {"rounds_per_s", f.rounds_per_s},
                      {"rounds", f.rounds},
@@ -303,7 +359,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                      {"ratio_to_floor", f.us_per_round / std::max(floor_us, 1e-9)}};
     }
     json["process"]["ratio_to_floor"] = process_ratio;
-    json["process"]["ratio_to_floor_per_repeat"] = process_ratios;
+    json["process_unpinned"]["ratio_to_floor"] = process_unpinned_ratio;
     if (secured) {
         json["pingpong_dds_security"] = {{"rounds", secured_floor->rounds},
                                          {"p50_us", secured_floor->p50_us},
@@ -316,7 +372,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                                         {"x_real_time", secured->x_real_time},
                                         {"startup_p50_s", secured->startup_p50_s},
                                         {"startup_p99_s", secured->startup_p99_s},
-                                        {"ratio_to_floor", secured->us_per_round / std::max(floor_us, 1e-9)},
+                                        {"ratio_to_floor", secured->us_per_round / std::max(pinned_floor.result.p50_us, 1e-9)},
                                         {"extra_us_per_round", secured->us_per_round - process.us_per_round}};
     }
     std::filesystem::create_directories(options.out_dir);

@@ -1,11 +1,13 @@
 #pragma once
 // `rig bench`: what the rig's lockstep costs, against the DDS floor.
-// For each case, N runs in process mode (the controller in its own process)
-// and N in software-in-the-loop mode (its plugin in the rig's process), one at
-// a time; in the same invocation, a DDS ping-pong between two processes on the
-// rig's profile with the clock's own message types (rig/host/dds_pingpong.h),
-// once before each repeat of the process-mode runs, each repeat judged against
-// the ping-pong just before it.
+// For each case, N runs in process mode (the controller in its own process) on
+// one leased CPU as `rig run` places them (rig/host/cpu_lease.h), N more left
+// to the scheduler (`--no-pin`), and N in software-in-the-loop mode (its plugin
+// in the rig's process), one at a time; in the same invocation, a DDS
+// ping-pong between two processes on the rig's profile with the clock's own
+// message types (rig/host/dds_pingpong.h), in each of the two placements,
+// once before each repeat of the process-mode runs of that placement, each
+// repeat judged against the ping-pong just before it.
 // One table: per mode, the wall time per round and rounds per second while
 // stepping, simulated over wall time per case, start-up to all matched (p50 /
 // p99), trace bytes per simulated minute, and the per-round cost as a ratio to

@@ -1,4 +1,5 @@
 #include "harness/trace_file.h"
+#include "rig/host/cpu_lease.h"
 
 #include <openssl/evp.h>
 #include <sqlite3.h>
@@ -138,6 +139,7 @@ void TraceFile::fail(const std::string& sqlite_error) {
 void TraceFile::digest(const std::string& canonical) { EVP_DigestUpdate(digest_, canonical.data(), canonical.size()); }
 
 void TraceFile::writer_loop() {
+    leave_leased_cpu();
     std::deque<PendingRow> batch;
     for (;;) {
         {

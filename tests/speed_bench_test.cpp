@@ -1,5 +1,5 @@
-// `rig bench` (issue 11): it runs, prints one table with the DDS floor and both
-// modes, and writes bench.json with what it measured. Behaviour only: the
+// `rig bench` (issue 11): it runs, prints one table with the DDS floor and the
+// modes in both placements, and writes bench.json with what it measured. Behaviour only: the
 // numbers are the machine's (a loaded CI runner's are not a claim), so nothing
 // here asserts a speed.
 #include <gtest/gtest.h>
@@ -21,17 +21,24 @@ TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
         "/cases/table5-6-continuation/continuation-6kmh.yaml --repeat 1 --pingpong-rounds 50 --out " + dir.string() +
         " 2>&1; echo \"exit=$?\"");
     EXPECT_NE(output.find("exit=0"), std::string::npos) << output;
-    EXPECT_NE(output.find("DDS ping-pong, 2 processes"), std::string::npos) << output;
-    EXPECT_NE(output.find("process mode"), std::string::npos) << output;
-    EXPECT_NE(output.find("in process (SIL)"), std::string::npos) << output;
-    EXPECT_NE(output.find("trace digests identical in every run of both modes"), std::string::npos) << output;
+    // Both placements (rig/host/cpu_lease.h): the floor and process mode on one leased CPU and on any.
+    EXPECT_NE(output.find("DDS ping-pong, 2 processes, 1 CPU"), std::string::npos) << output;
+    EXPECT_NE(output.find("process mode, 1 CPU (default)"), std::string::npos) << output;
+    EXPECT_NE(output.find("in process (SIL), 1 CPU"), std::string::npos) << output;
+    EXPECT_NE(output.find("DDS ping-pong, 2 processes, any CPU"), std::string::npos) << output;
+    EXPECT_NE(output.find("process mode, any CPU (--no-pin)"), std::string::npos) << output;
+    EXPECT_NE(output.find("trace digests identical in every run of every mode"), std::string::npos) << output;
 
     ASSERT_TRUE(std::filesystem::exists(dir / "bench.json")) << output;
     const nlohmann::json bench = nlohmann::json::parse(read_all(dir / "bench.json"));
     EXPECT_TRUE(bench.at("digests_identical").get<bool>());
-    EXPECT_EQ(bench.at("pingpong").at("rounds").get<int>(), 50);
-    EXPECT_GT(bench.at("pingpong").at("p50_us").get<double>(), 0.0);
-    for (const char* mode : {"process", "in_process"}) {
+    for (const char* floor : {"pingpong", "pingpong_unpinned"}) {
+        SCOPED_TRACE(floor);
+        EXPECT_EQ(bench.at(floor).at("rounds").get<int>(), 50);
+        EXPECT_GT(bench.at(floor).at("p50_us").get<double>(), 0.0);
+    }
+    EXPECT_TRUE(bench.at("thread_id_cache").get<bool>());
+    for (const char* mode : {"process", "process_unpinned", "in_process"}) {
         SCOPED_TRACE(mode);
         const nlohmann::json& figures = bench.at(mode);
         // One run of a 66.7 s case on the 100 Hz device grid: thousands of rounds.
@@ -41,8 +48,10 @@ TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
         EXPECT_GT(figures.at("trace_bytes_per_sim_minute").get<double>(), 0.0);
         EXPECT_GT(figures.at("startup_p50_s").get<double>(), 0.0);
     }
-    // Both modes recorded the same samples: the same trace size.
+    // Every mode recorded the same samples: the same trace size.
     EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"), bench.at("in_process").at("trace_bytes_per_sim_minute"));
+    EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"),
+              bench.at("process_unpinned").at("trace_bytes_per_sim_minute"));
 }
 
 TEST(SpeedBench, WithDdsSecurityAddsTheSecuredFloorAndProcessModeWithTheSameDigest) {
