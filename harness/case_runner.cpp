@@ -579,7 +579,8 @@ std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOpti
     return run_cases(specs, options, observer);
 }
 
-std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer) {
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer,
+                               RunPhaseWalls* phase_walls) {
     const std::vector<CaseInstance> instances = expand_runs(specs, options);
     std::vector<CaseRun> runs(instances.size());
     observer.runs_planned(instances, specs);
@@ -609,10 +610,14 @@ std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOpti
         for (std::size_t k = next++; k < lockstep.size(); k = next++) run_one(lockstep[k]);
     };
     const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(lockstep.size())));
+    const WallStopwatch lockstep_phase;
     std::vector<std::thread> threads;
     for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
     for (auto& thread : threads) thread.join();
+    if (phase_walls != nullptr) phase_walls->lockstep_seconds = lockstep_phase.elapsed_s();
+    const WallStopwatch realtime_phase;
     for (std::size_t i : realtime) run_one(i);
+    if (phase_walls != nullptr) phase_walls->realtime_seconds = realtime_phase.elapsed_s();
     return runs;
 }
 

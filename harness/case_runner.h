@@ -99,11 +99,21 @@ public:
     virtual CaseClock* case_clock(std::size_t index) = 0;
 };
 
+// The wall time of run_cases' two phases: the lockstep cases (`jobs` at a
+// time), then the real-time ones (alone). A real-time case runs at 1x by
+// definition, so the rig's speed is the first phase's figure.
+struct RunPhaseWalls {
+    double lockstep_seconds = 0.0;
+    double realtime_seconds = 0.0;
+};
+
 // Runs every expanded case `options.jobs` at a time (real-time cases alone,
 // after the others), telling `observer` as cases start and end. After SIGINT /
 // SIGTERM (harness/run_interrupt.h) the running cases end as interrupted and
-// the rest are reported as not run.
-std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer);
+// the rest are reported as not run. `phase_walls`, if given, gets each phase's
+// wall time.
+std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, RunObserver& observer,
+                               RunPhaseWalls* phase_walls = nullptr);
 // The same, printing one progress line per case as it ends (harness/run_progress.h CaseLineLog).
 std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOptions& options, std::ostream& progress);
 

@@ -175,7 +175,8 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     const std::string started_utc = rig::utc_date_time_now();
     TerminalProgress* terminal = nullptr;
     const std::unique_ptr<RunObserver> observer = progress_observer(verbosity, options.jobs, terminal);
-    const auto runs = run_cases(specs, options, *observer);
+    RunPhaseWalls phase_walls;
+    const auto runs = run_cases(specs, options, *observer, &phase_walls);
     if (terminal != nullptr) terminal->finish();
     std::vector<CaseResult> results;
     std::vector<CaseFigures> figures;
@@ -185,6 +186,8 @@ int run_command(const std::vector<std::string>& inputs, const rig::harness::RunO
     }
     RunSummary summary = summarize(results);
     summary.wall_seconds = wall.elapsed_s();  // with --jobs > 1 cases overlap
+    summary.lockstep_wall_seconds = phase_walls.lockstep_seconds;
+    summary.realtime_wall_seconds = phase_walls.realtime_seconds;
     summary.started_utc = started_utc;
     // A disk that filled during the run: the table still goes to the terminal,
     // the failure is told, never an abort (harness/output_dir.h).

@@ -404,6 +404,7 @@ RunSummary summarize(const std::vector<CaseResult>& results) {
         }
         summary.sim_seconds += result.sim_seconds;
         summary.wall_seconds += result.wall_seconds;
+        (result.mode == "realtime" ? summary.realtime_sim_seconds : summary.lockstep_sim_seconds) += result.sim_seconds;
     }
     return summary;
 }
@@ -467,19 +468,30 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
         }
         cases.push_back(std::move(one_case));
     }
+    nlohmann::json summary_json = {
+        {"passed", summary.passed},
+        {"failed", summary.failed},
+        {"invalid", summary.invalid},
+        {"total", summary.passed + summary.failed + summary.invalid},
+        {"sim_seconds", summary.sim_seconds},
+        {"wall_seconds", summary.wall_seconds},
+    };
+    // The speed figure (lockstep) apart from the real-time cases, which run at 1x.
+    auto phase = [](double sim_seconds, const std::optional<double>& wall_seconds) {
+        nlohmann::json json = {{"sim_seconds", sim_seconds}};
+        if (wall_seconds) {
+            json["wall_seconds"] = *wall_seconds;
+            json["x_real_time"] = *wall_seconds > 0.0 ? nlohmann::json(sim_seconds / *wall_seconds) : nlohmann::json();
+        }
+        return json;
+    };
+    summary_json["lockstep"] = phase(summary.lockstep_sim_seconds, summary.lockstep_wall_seconds);
+    summary_json["realtime"] = phase(summary.realtime_sim_seconds, summary.realtime_wall_seconds);
     return {
         {"schema_version", kResultsSchemaVersion},
         {"rig", {{"version", std::string(rig_version())}, {"commit", std::string(rig_commit())}}},
         {"cases", std::move(cases)},
-        {"summary",
-         {
-             {"passed", summary.passed},
-             {"failed", summary.failed},
-             {"invalid", summary.invalid},
-             {"total", summary.passed + summary.failed + summary.invalid},
-             {"sim_seconds", summary.sim_seconds},
-             {"wall_seconds", summary.wall_seconds},
-         }},
+        {"summary", std::move(summary_json)},
     };
 }
 
@@ -620,7 +632,20 @@ std::string result_table(const std::vector<CaseResult>& results, const RunSummar
         }
     }
     table += "\nsimulated " + format_fixed(summary.sim_seconds, 1) + " s in " + format_fixed(summary.wall_seconds, 1) +
-             " s wall\n";
+             " s wall";
+    if (summary.lockstep_wall_seconds && summary.lockstep_sim_seconds > 0.0 && summary.realtime_sim_seconds > 0.0) {
+        // Apart: a real-time case runs at 1x by definition.
+        table += " (lockstep " + format_fixed(summary.lockstep_sim_seconds, 1) + " s in " +
+                 format_fixed(*summary.lockstep_wall_seconds, 1) + " s, " +
+                 format_fixed(summary.lockstep_sim_seconds / std::max(*summary.lockstep_wall_seconds, 1e-9), 1) +
+                 "x; real time " + format_fixed(summary.realtime_sim_seconds, 1) + " s";
+        if (summary.realtime_wall_seconds) table += " in " + format_fixed(*summary.realtime_wall_seconds, 1) + " s";
+        table += ")";
+    } else if (summary.lockstep_wall_seconds && summary.lockstep_sim_seconds > 0.0) {
+        table += ", " + format_fixed(summary.lockstep_sim_seconds / std::max(*summary.lockstep_wall_seconds, 1e-9), 1) +
+                 "x real time";
+    }
+    table += "\n";
     // Kept alone on the last line: CI log readers look for "N passed, N failed".
     table += std::to_string(summary.passed) + " passed, " + std::to_string(summary.failed) + " failed" +
              (summary.invalid > 0 ? ", " + std::to_string(summary.invalid) + " invalid (rig overloaded: not judged)" : "") +

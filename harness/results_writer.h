@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -71,6 +72,14 @@ struct RunSummary {
     int invalid = 0;  // rig overloaded: neither passed nor failed (case_invalid)
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
+    // Split by time mode: a real-time case runs at 1x by definition, so the
+    // rig's speed is the lockstep figure. The walls are those of run_cases'
+    // two phases (harness/case_runner.h RunPhaseWalls), known only to the run
+    // that ran the cases (not to `rig judge` or `rig merge`).
+    double lockstep_sim_seconds = 0.0;
+    double realtime_sim_seconds = 0.0;
+    std::optional<double> lockstep_wall_seconds;
+    std::optional<double> realtime_wall_seconds;
     // When the run started, UTC, "2026-11-24T12:05:09" (junit.xml's timestamp);
     // empty: junit_xml() takes the time it is written.
     std::string started_utc;

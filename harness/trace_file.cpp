@@ -139,6 +139,8 @@ void TraceFile::fail(const std::string& sqlite_error) {
 void TraceFile::digest(const std::string& canonical) { EVP_DigestUpdate(digest_, canonical.data(), canonical.size()); }
 
 void TraceFile::writer_loop() {
+    // Started by a lockstep case's thread on its leased CPU (rig/host/cpu_lease.h):
+    // the batches of rows are written beside the loop, not in its chain.
     leave_leased_cpu();
     std::deque<PendingRow> batch;
     for (;;) {

@@ -201,6 +201,39 @@ TEST(Summary, CountsCasesWithErrorsAsFailed) {
     EXPECT_DOUBLE_EQ(summary.wall_seconds, 11.3);
 }
 
+TEST(Summary, GivesTheLockstepSpeedApartFromRealTimeCases) {
+    std::vector<CaseResult> results = all_cases();  // lockstep: 62.5 + 40 s simulated
+    CaseResult wired = passing_case();
+    wired.name = "wired-6kmh";
+    wired.mode = "realtime";
+    wired.sim_seconds = 30.0;
+    results.push_back(wired);
+    RunSummary summary = summarize(results);
+    EXPECT_DOUBLE_EQ(summary.lockstep_sim_seconds, 102.5);
+    EXPECT_DOUBLE_EQ(summary.realtime_sim_seconds, 30.0);
+    EXPECT_FALSE(summary.lockstep_wall_seconds.has_value());  // only the run that ran them knows
+    const std::string without_walls = result_table(results, summary, /*color=*/false);
+    EXPECT_EQ(without_walls.find("lockstep"), std::string::npos) << without_walls;
+
+    summary.wall_seconds = 33.0;
+    summary.lockstep_wall_seconds = 2.0;
+    summary.realtime_wall_seconds = 31.0;
+    const std::string table = result_table(results, summary, /*color=*/false);
+    EXPECT_NE(table.find("simulated 132.5 s in 33.0 s wall (lockstep 102.5 s in 2.0 s, 51.2x; real time 30.0 s in 31.0 s)"),
+              std::string::npos)
+        << table;
+    const nlohmann::json json = results_json(results, summary)["summary"];
+    EXPECT_DOUBLE_EQ(json["lockstep"]["sim_seconds"].get<double>(), 102.5);
+    EXPECT_DOUBLE_EQ(json["lockstep"]["x_real_time"].get<double>(), 51.25);
+    EXPECT_DOUBLE_EQ(json["realtime"]["wall_seconds"].get<double>(), 31.0);
+
+    // Lockstep cases alone: the speed on the same line.
+    results.pop_back();
+    RunSummary lockstep_only = summarize(results);
+    lockstep_only.lockstep_wall_seconds = 2.0;
+    EXPECT_NE(result_table(results, lockstep_only, false).find(" s wall, 51.2x real time\n"), std::string::npos);
+}
+
 // ------------------------------------------------------------------ results.json
 
 TEST(ResultsJson, MatchesTheDesignContract) {
