@@ -11,6 +11,8 @@
 #include <thread>
 #include <tuple>
 
+#include <sys/resource.h>
+
 #include <nlohmann/json.hpp>
 
 #include "harness/dds_security_setup.h"
@@ -28,7 +30,18 @@ struct ModeRuns {
     std::string mode;  // process (one leased CPU), process_unpinned, in_process, process_dds_security
     std::vector<CaseResult> runs;
     std::vector<int> repeat_of;  // per run: which repeat (0-based) it belongs to
+    std::uint64_t context_switches = 0;  // over all its runs (context_switches_so_far)
 };
+
+// Context switches, voluntary and not, of every thread of this process and of
+// its children that have ended and been waited for (a case's controller
+// process, the ping-pong's second process): the hand-offs a round costs.
+std::uint64_t context_switches_so_far() {
+    rusage self{}, children{};
+    getrusage(RUSAGE_SELF, &self);
+    getrusage(RUSAGE_CHILDREN, &children);
+    return static_cast<std::uint64_t>(self.ru_nvcsw + self.ru_nivcsw + children.ru_nvcsw + children.ru_nivcsw);
+}
 
 // The rig's own participants hold the run's rig identity while a secured mode
 // runs, and none again after it (rig/runtime/dds_security.h).
@@ -190,10 +203,14 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     // runs by default, and left to the scheduler, as with `rig run --no-pin`.
     // Each process-mode row is judged against the floor of its own placement.
     std::vector<PingPongResult> floors_pinned, floors_free;
+    std::uint64_t floor_switches_pinned = 0, floor_switches_free = 0;
     std::optional<PingPongResult> secured_floor;
     auto measure_floor = [&](bool pin) {
         const CpuLease cpu(pin);
-        return run_dds_pingpong(options.pingpong);
+        const std::uint64_t switches_before = context_switches_so_far();
+        PingPongResult result = run_dds_pingpong(options.pingpong);
+        (pin ? floor_switches_pinned : floor_switches_free) += context_switches_so_far() - switches_before;
+        return result;
     };
     try {
         if (credentials) {
@@ -237,7 +254,9 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 if (secured) run_options.dds_security_dir = credentials->dir;
                 const RigIdentityScope rig_identity(secured ? credentials : std::nullopt);
                 const std::vector<CaseInstance> instances = expand_runs({spec}, run_options);
+                const std::uint64_t switches_before = context_switches_so_far();
                 const CaseRun run = run_case(spec, instances.front().seed, instances.front().name, run_options);
+                mode.context_switches += context_switches_so_far() - switches_before;
                 const CaseResult& result = run.result;
                 const std::string expected_mode = mode.mode == "in_process" ? "in_process" : "process";
                 if (!result.error.empty() || result.controller_mode != expected_mode) {
@@ -321,6 +340,23 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
            "the ping-pong's likewise; vs floor:\n  us/round / the p50 of the ping-pong in the same placement "
            "(process mode: each repeat over the ping-pong\n  measured just before it, the median of those; SIL over "
            "the median one-CPU ping-pong).\n";
+    // Hand-offs: a round trip of the ping-pong against a round (whole runs: start-up and judging included).
+    auto per_round = [](std::uint64_t switches, std::uint64_t rounds) {
+        return rounds > 0 ? static_cast<double>(switches) / static_cast<double>(rounds) : 0.0;
+    };
+    const std::uint64_t floor_round_trips =
+        static_cast<std::uint64_t>(options.pingpong.rounds + options.pingpong.warmup_rounds);
+    const double floor_switches_pinned_per_round = per_round(floor_switches_pinned, floor_round_trips * floors_pinned.size());
+    const double floor_switches_free_per_round = per_round(floor_switches_free, floor_round_trips * floors_free.size());
+    const double process_switches_per_round = per_round(modes[0].context_switches, process.rounds);
+    const double process_unpinned_switches_per_round = per_round(modes[1].context_switches, process_unpinned.rounds);
+    const double in_process_switches_per_round = per_round(modes[2].context_switches, in_process.rounds);
+    out << "  context switches a round (both processes, every thread; a case's start-up and judging included):\n"
+           "    1 CPU: ping-pong "
+        << fixed(floor_switches_pinned_per_round, 1) << ", process mode " << fixed(process_switches_per_round, 1)
+        << ", SIL " << fixed(in_process_switches_per_round, 1) << "; any CPU: ping-pong "
+        << fixed(floor_switches_free_per_round, 1) << ", process mode " << fixed(process_unpinned_switches_per_round, 1)
+        << "\n";
     if (process.us_per_round > 0.0 && pinned_floor.result.p50_us > 0.0) {
         out << "  one CPU against any CPU: process mode " << fixed(process_unpinned.us_per_round / process.us_per_round, 2)
             << "x as fast a round, the ping-pong " << fixed(free_floor.result.p50_us / pinned_floor.result.p50_us, 2)
@@ -360,6 +396,11 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     }
     json["process"]["ratio_to_floor"] = process_ratio;
     json["process_unpinned"]["ratio_to_floor"] = process_unpinned_ratio;
+    json["process"]["context_switches_per_round"] = process_switches_per_round;
+    json["process_unpinned"]["context_switches_per_round"] = process_unpinned_switches_per_round;
+    json["in_process"]["context_switches_per_round"] = in_process_switches_per_round;
+    json["pingpong"]["context_switches_per_round"] = floor_switches_pinned_per_round;
+    json["pingpong_unpinned"]["context_switches_per_round"] = floor_switches_free_per_round;
     if (secured) {
         json["pingpong_dds_security"] = {{"rounds", secured_floor->rounds},
                                          {"p50_us", secured_floor->p50_us},

@@ -38,6 +38,10 @@ TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
         EXPECT_GT(bench.at(floor).at("p50_us").get<double>(), 0.0);
     }
     EXPECT_TRUE(bench.at("thread_id_cache").get<bool>());
+    EXPECT_NE(output.find("context switches a round"), std::string::npos) << output;
+    // Every round of process mode hands off to the controller's process and back.
+    EXPECT_GT(bench.at("process").at("context_switches_per_round").get<double>(), 1.0);
+    EXPECT_GT(bench.at("pingpong").at("context_switches_per_round").get<double>(), 1.0);
     for (const char* mode : {"process", "process_unpinned", "in_process"}) {
         SCOPED_TRACE(mode);
         const nlohmann::json& figures = bench.at(mode);
