@@ -1,11 +1,12 @@
 #include "harness/trace_file.h"
-#include "rig/host/cpu_lease.h"
 
 #include <openssl/evp.h>
 #include <sqlite3.h>
 
 #include <iostream>
 #include <stdexcept>
+
+#include "rig/host/cpu_lease.h"
 
 namespace rig::harness {
 
