@@ -125,8 +125,8 @@ FloorFigures floor_figures_of(const std::vector<PingPongResult>& slices, std::ui
     return f;
 }
 
-// Each repeat's us/round over the ping-pong measured just before it; the median of those.
-double median_ratio_to_floor(const ModeRuns& mode, const std::vector<PingPongResult>& floors) {
+// Each repeat's us/round over the ping-pong measured just before it.
+std::vector<double> ratios_to_floor(const ModeRuns& mode, const std::vector<PingPongResult>& floors) {
     std::vector<double> ratios;
     for (std::size_t r = 0; r < floors.size(); ++r) {
         std::vector<CaseResult> runs_of_repeat;
@@ -136,7 +136,7 @@ double median_ratio_to_floor(const ModeRuns& mode, const std::vector<PingPongRes
         if (runs_of_repeat.empty() || floors[r].p50_us <= 0.0) continue;
         ratios.push_back(figures_of(runs_of_repeat).us_per_round / floors[r].p50_us);
     }
-    return percentile(ratios, 0.5);
+    return ratios;
 }
 
 std::string load_average() {
@@ -284,8 +284,10 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     const ModeFigures in_process = figures_of(modes[2].runs);
     const FloorFigures pinned_floor = floor_figures_of(floors_pinned, options.pingpong.rounds);
     const FloorFigures free_floor = floor_figures_of(floors_free, options.pingpong.rounds);
-    const double process_ratio = median_ratio_to_floor(modes[0], floors_pinned);
-    const double process_unpinned_ratio = median_ratio_to_floor(modes[1], floors_free);
+    const std::vector<double> process_ratios = ratios_to_floor(modes[0], floors_pinned);
+    const std::vector<double> process_unpinned_ratios = ratios_to_floor(modes[1], floors_free);
+    const double process_ratio = percentile(process_ratios, 0.5);
+    const double process_unpinned_ratio = percentile(process_unpinned_ratios, 0.5);
     double sim_per_case = 0.0;
     for (const CaseResult& run : modes[0].runs) sim_per_case += run.sim_seconds;
     if (!modes[0].runs.empty()) sim_per_case /= static_cast<double>(modes[0].runs.size());
@@ -395,7 +397,9 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                      {"ratio_to_floor", f.us_per_round / std::max(floor_us, 1e-9)}};
     }
     json["process"]["ratio_to_floor"] = process_ratio;
+    json["process"]["ratio_to_floor_per_repeat"] = process_ratios;
     json["process_unpinned"]["ratio_to_floor"] = process_unpinned_ratio;
+    json["process_unpinned"]["ratio_to_floor_per_repeat"] = process_unpinned_ratios;
     json["process"]["context_switches_per_round"] = process_switches_per_round;
     json["process_unpinned"]["context_switches_per_round"] = process_unpinned_switches_per_round;
     json["in_process"]["context_switches_per_round"] = in_process_switches_per_round;

@@ -1,9 +1,7 @@
 #include "rig/host/cpu_lease.h"
 
-#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,6 +9,8 @@
 #include <memory>
 #include <mutex>
 #include <vector>
+
+#include "rig/host/lease_file.h"
 
 namespace rig {
 
@@ -87,13 +87,8 @@ CpuLease::CpuLease(bool pin, const std::filesystem::path& lock_dir) {
         return;
     }
     for (int cpu : cpus) {
-        const std::string path = (lock_dir / ("rig-cpu-" + std::to_string(cpu) + ".lock")).string();
-        const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+        const int fd = try_lease_file((lock_dir / ("rig-cpu-" + std::to_string(cpu) + ".lock")).string());
         if (fd < 0) continue;
-        if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-            ::close(fd);
-            continue;
-        }
         cpu_set_t one;
         CPU_ZERO(&one);
         CPU_SET(cpu, &one);

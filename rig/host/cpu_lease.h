@@ -5,7 +5,8 @@
 // controller's thread, which answers through the rig's receiving thread to the
 // rig's thread. Nothing in the chain runs in parallel with the rest. Spread over
 // the machine's CPUs, each hand-off wakes a CPU that went idle (on this
-// machine's virtual CPUs, a halted one: 20-60 us) and the woken thread often
+// machine's virtual CPUs, a halted one: 61 us in one round of a perf scheduler
+// trace, itself slowed by the tracing) and the woken thread often
 // preempts its waker while the waker still holds the lock it wants. On one CPU,
 // with SCHED_BATCH (no wake-up preemption: the woken thread runs when the
 // waker blocks), a hand-off is a plain context switch. Measured with `rig

@@ -1,11 +1,11 @@
 #include "rig/host/domain_lease.h"
 
-#include <fcntl.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <stdexcept>
+
+#include "rig/host/lease_file.h"
 
 namespace rig {
 
@@ -20,11 +20,8 @@ DomainLease DomainLease::acquire(std::uint32_t first, std::uint32_t last) {
     const std::uint32_t start = next.fetch_add(1) % span;
     for (std::uint32_t k = 0; k < span; ++k) {
         const std::uint32_t domain = first + (start + k) % span;
-        const std::string path = "/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock";
-        const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-        if (fd < 0) continue;
-        if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return DomainLease(domain, fd);
-        ::close(fd);
+        const int fd = try_lease_file("/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock");
+        if (fd >= 0) return DomainLease(domain, fd);
     }
     throw std::runtime_error("no free DDS domain id in [" + std::to_string(first) + ", " + std::to_string(last) +
                              "]: too many rig runs at once?");
@@ -34,10 +31,10 @@ DomainLease DomainLease::acquire_exact(std::uint32_t domain) {
     // Fast DDS's well-known ports (7400 + 250 domain + ...) run out above 232.
     if (domain > 232) throw std::runtime_error("DDS domain " + std::to_string(domain) + " is above 232");
     const std::string path = "/tmp/rig-dds-domain-" + std::to_string(domain) + ".lock";
-    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-    if (fd < 0) throw std::runtime_error("cannot open " + path + " to lease DDS domain " + std::to_string(domain));
-    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return DomainLease(domain, fd);
-    ::close(fd);
+    int open_error = 0;
+    const int fd = try_lease_file(path, &open_error);
+    if (fd >= 0) return DomainLease(domain, fd);
+    if (open_error != 0) throw std::runtime_error("cannot open " + path + " to lease DDS domain " + std::to_string(domain));
     throw std::runtime_error("DDS domain " + std::to_string(domain) + " is in use by another rig run (" + path + ")");
 }
 
