@@ -10,7 +10,7 @@ namespace rig::controller {
 
 namespace {
 
-// Every number has a range with its physical reason (as in harness/case_spec.cpp):
+// Every number has a range with its physical reason (as in harness/spec/case_spec.cpp):
 // a finite value far outside physics would otherwise pass and overflow a timer
 // or a count at run time. Rates and periods are timers of simulated int64 ns,
 // so each has a positive lower bound.
@@ -185,7 +185,7 @@ CalibrationRunConfig read_calibration_run(const YamlSection& section) {
 
 ControllerConfig parse_controller_config(const YamlSection& section) {
     ControllerConfig config;
-    // The rig's own keys of the section (harness/case_spec.h kControllerRigKeys):
+    // The rig's own keys of the section (harness/spec/case_spec.h kControllerRigKeys):
     // how to run the controller, not how it behaves.
     for (const char* rig_key : {"command", "plugin", "in_process"}) section.allow(rig_key);
     static constexpr std::array<EnumChoice<Positioning>, 2> kPositioning{

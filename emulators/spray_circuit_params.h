@@ -1,7 +1,7 @@
 #pragma once
 // The spray circuit's parameters (emulators/spray_circuit.h has what each models
 // and from where), apart from the circuit so that what only needs the values - the
-// case file's defaults (harness/case_spec.h), the fuzz build, tools - does not pull
+// case file's defaults (harness/spec/case_spec.h), the fuzz build, tools - does not pull
 // in the plant, its clock and Fast DDS.
 #include <vector>
 

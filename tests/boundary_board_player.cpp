@@ -86,7 +86,11 @@ int main(int argc, char** argv) {
         rig::DdsContext dds(domain, "pi_player");
         rig::controller::boundary::BoundaryControllerNode pi(
             "pi_player",
-            rig::controller::boundary::load_boundary_node_config(attach_file.parent_path() / "controller.yaml"), lines);
+            // Its configuration, and the job the rig named in attach.json (the target areas, the cameras).
+            rig::controller::boundary::load_boundary_node_config(
+                attach_file.parent_path() / "controller.yaml",
+                attach_file.parent_path() / attach.at("job").get<std::string>()),
+            lines);
         pi.configure(dds);
         // A Pi's controller loop runs at real-time priority, as the reference controller asks.
         std::cout << "boundary_board_player: " << rig::request_realtime_scheduling(40).detail << std::endl;

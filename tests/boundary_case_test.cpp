@@ -1,7 +1,9 @@
-// Seed 001's boundary cases without DDS: the loader (harness/boundary_case.h
-// through the case loader), the judging plan's round trip through the trace's
-// JSON, and the judge's rebuilding of the ground and of flow per duty from
-// truth samples with a known answer (harness/boundary_judge.h).
+// Seed 001's boundary cases without DDS: the loader (harness/systems/boundary/
+// boundary_case.h through the case loader), the job a seed-001 controller is
+// given and the reference controller's reading of it, the judging plan's round
+// trip through the trace's JSON, and the judge's rebuilding of the ground and
+// of flow per duty from truth samples with a known answer
+// (harness/systems/boundary/boundary_judge.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,9 +12,12 @@
 #include <sstream>
 #include <string>
 
-#include "harness/boundary_case.h"
-#include "harness/boundary_judge.h"
-#include "harness/case_spec.h"
+#include "controller/boundary/boundary_node_config.h"
+#include "harness/spec/case_spec.h"
+#include "harness/systems/boundary/boundary_case.h"
+#include "harness/systems/boundary/boundary_judge.h"
+#include "harness/systems/systems.h"
+#include "run_support.h"
 
 namespace {
 
@@ -46,9 +51,8 @@ std::string load_error(const std::string& text) {
 
 TEST(BoundaryCase, TheShippedDriveOutCaseReadsAsWritten) {
     const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
-    ASSERT_EQ(spec.system, CaseSystem::boundary);
-    ASSERT_TRUE(spec.boundary);
-    const BoundaryCaseSpec& b = *spec.boundary;
+    ASSERT_EQ(system_of(spec).name(), "boundary");
+    const BoundarySections& b = boundary_sections(spec);
     EXPECT_EQ(b.corners.size(), 4u);
     EXPECT_DOUBLE_EQ(b.route_start.position.north_m, -12.0);
     EXPECT_EQ(b.route_segments.size(), 2u);
@@ -57,10 +61,59 @@ TEST(BoundaryCase, TheShippedDriveOutCaseReadsAsWritten) {
     EXPECT_EQ(spec.seeds, (std::vector<std::uint64_t>{1, 2, 3}));
     // No seed-000 default limit is added to a boundary case.
     EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"drive_out_excess_mean_m", 0.50}}));
-    // The controller is told the area (its corners as recorded) unless its section gives its own.
-    ASSERT_TRUE(spec.controller.params.node["areas"]);
-    EXPECT_EQ(spec.controller.params.node["areas"][0]["corners"].size(), 4u);
-    EXPECT_DOUBLE_EQ(spec.controller.params.node["areas"][0]["density"].as<double>(), 0.5);
+    // The controller's section is the controller's, as written: the rig adds none of its keys.
+    EXPECT_FALSE(spec.controller.params.present && spec.controller.params.node["areas"]);
+}
+
+// The area goes to the controller in the job (docs/controller-contract.md "The
+// job"), which the reference controller reads back to the same numbers: its
+// areas unless its section names its own, and the cameras when the case has them.
+TEST(BoundaryCase, TheJobCarriesTheAreaAndTheCamerasToTheController) {
+    const fs::path dir = rig::testing::fresh_dir("boundary-job");
+    const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
+    const std::vector<std::string> args = system_of(spec).plan_run(spec, 1)->write_controller_inputs(dir);
+    ASSERT_EQ(args, (std::vector<std::string>{"--job", (dir / "job.yaml").string()}));
+    const rig::controller::boundary::BoundaryJob job = rig::controller::boundary::load_boundary_job(dir / "job.yaml");
+    const BoundarySections& b = boundary_sections(spec);
+    ASSERT_EQ(job.areas.size(), 1u);
+    EXPECT_EQ(job.areas[0].name, b.area_name);
+    EXPECT_EQ(job.areas[0].density, b.area_density);
+    ASSERT_EQ(job.areas[0].corners.size(), b.corners.size());
+    for (std::size_t i = 0; i < b.corners.size(); ++i) {
+        EXPECT_EQ(job.areas[0].corners[i].lat_deg, b.corners[i].lat_deg);  // exactly: the same double
+        EXPECT_EQ(job.areas[0].corners[i].lon_deg, b.corners[i].lon_deg);
+    }
+    EXPECT_FALSE(job.cameras);
+    // Without areas of its own the controller takes the job's; its own win.
+    const auto config = [&](const std::string& section) {
+        return rig::controller::boundary::parse_boundary_node_config(
+            rig::YamlSection::load_string(section, "controller.yaml"), job);
+    };
+    EXPECT_EQ(config("{}").controller.areas.size(), 1u);
+    const auto own = config("areas: [ { name: mine, corners: [ { lat_deg: 1, lon_deg: 1 }, { lat_deg: 1, lon_deg: 1.001 }, "
+                            "{ lat_deg: 1.001, lon_deg: 1 } ] } ]");
+    ASSERT_EQ(own.controller.areas.size(), 1u);
+    EXPECT_EQ(own.controller.areas[0].name, "mine");
+    EXPECT_FALSE(config("{}").vision.enabled);
+
+    // A vision case: the cameras, and the calibration scene's end, in the job.
+    const CaseSpec vision =
+        parse_case(shipped("seed001-vision-faults/calibrated-turned-camera.yaml"), "vision.yaml");
+    const fs::path vision_dir = rig::testing::fresh_dir("boundary-job-vision");
+    system_of(vision).plan_run(vision, 1)->write_controller_inputs(vision_dir);
+    const rig::controller::boundary::BoundaryJob with_cameras =
+        rig::controller::boundary::load_boundary_job(vision_dir / "job.yaml");
+    EXPECT_TRUE(with_cameras.cameras);
+    EXPECT_EQ(with_cameras.left_camera_topic, "device/camera_left/frame");
+    EXPECT_GT(with_cameras.calibration_scene_until_s, 0.0);
+    const auto node = rig::controller::boundary::parse_boundary_node_config(
+        rig::YamlSection::load_string("{}", "controller.yaml"), with_cameras);
+    EXPECT_TRUE(node.vision.enabled);
+    EXPECT_EQ(node.vision.calibration_until_s, with_cameras.calibration_scene_until_s);
+    // A section that says how to see keeps its say.
+    EXPECT_FALSE(rig::controller::boundary::parse_boundary_node_config(
+                     rig::YamlSection::load_string("vision: { enabled: false }", "controller.yaml"), with_cameras)
+                     .vision.enabled);
 }
 
 TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
@@ -131,7 +184,7 @@ TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {
 
 TEST(BoundaryJudge, ThePlanSurvivesTheTracesJson) {
     const CaseSpec spec = parse_case(shipped("seed001-table8-boundary/drive-out.yaml"), "drive-out.yaml");
-    const BoundaryJudgingPlan plan = plan_boundary_judging(*spec.boundary);
+    const BoundaryJudgingPlan plan = plan_boundary_judging(boundary_sections(spec));
     // The north edge (north = 0), the area on its left: from east +10 to -10.
     ASSERT_EQ(plan.edges.size(), 1u);
     EXPECT_NEAR(plan.edges[0].edge.from_east_m, 10.0, 1e-3);

@@ -15,7 +15,7 @@
 #include "emulators/boundary_spray_plant.h"
 #include "emulators/field2d/polygon.h"
 #include "emulators/l4_laser_sensor.h"
-#include "harness/boundary_metrics.h"
+#include "harness/systems/boundary/boundary_metrics.h"
 
 namespace {
 

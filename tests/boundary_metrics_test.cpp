@@ -1,4 +1,4 @@
-// Seed 001's boundary and flow metrics (harness/boundary_metrics.h) on plain
+// Seed 001's boundary and flow metrics (harness/systems/boundary/boundary_metrics.h) on plain
 // data with known answers: the paper's own Table 7 / 8 values for the
 // statistics, hand-made rasters for the wet edge, Table 3 for Eq. 13's fit.
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "emulators/field2d/nozzle_flow_table.h"
-#include "harness/boundary_metrics.h"
+#include "harness/systems/boundary/boundary_metrics.h"
 
 namespace {
 

@@ -9,7 +9,7 @@
 
 #include "emulators/boundary_spray_plant.h"
 #include "emulators/field2d/nozzle_flow_table.h"
-#include "harness/boundary_metrics.h"
+#include "harness/systems/boundary/boundary_metrics.h"
 
 namespace {
 
@@ -22,20 +22,10 @@ using rig::emulators::SprayDepositionParams;
 using rig::harness::BoundaryEdge;
 using rig::harness::DoseRaster;
 using rig::harness::EdgeProbe;
+using rig::harness::raster_of;
 using rig::harness::wet_edge_profile;
 
 const LocalFrame kFrame(35.1, 113.3, 90.0);
-
-DoseRaster raster_of(const DepositionGrid2d& grid, int nozzle) {
-    DoseRaster r;
-    r.east0_m = grid.origin().east_m;
-    r.north0_m = grid.origin().north_m;
-    r.cell_m = grid.cell_m();
-    r.nx = grid.nx();
-    r.ny = grid.ny();
-    r.dose_ul_cm2 = grid.dose_layer_ul_cm2(nozzle);
-    return r;
-}
 
 // North at 1 m/s from the rear axle at (0, -5): the boom centre (1.6 + 1.0 m
 // ahead, Eq. 18 at 0.5 m) is at north t - 2.4 and crosses north = 0 at 2.4 s.

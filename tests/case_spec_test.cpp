@@ -1,6 +1,8 @@
 // Case files: a full file, defaults, and a table of broken files with the exact
 // `file:line:col: key:` each must be reported at.
-#include "harness/case_spec.h"
+#include "harness/spec/case_spec.h"
+#include "harness/systems/breakpoint/breakpoint_case.h"
+#include "harness/systems/systems.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -143,51 +145,51 @@ TEST(CaseSpec, FullFileParsesToTheWrittenValues) {
     EXPECT_EQ(spec.description, "free text");
     EXPECT_EQ(spec.seed, 7u);
     EXPECT_EQ(spec.mode, RunMode::realtime);
-    EXPECT_EQ(spec.utc_start_iso, "2023-07-15T02:00:00.25Z");
-    EXPECT_EQ(spec.utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h + 250ms);
+    EXPECT_EQ(breakpoint_sections(spec).utc_start_iso, "2023-07-15T02:00:00.25Z");
+    EXPECT_EQ(breakpoint_sections(spec).utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h + 250ms);
 
-    EXPECT_DOUBLE_EQ(spec.field.origin.lat_deg, 40.18);
-    EXPECT_DOUBLE_EQ(spec.field.origin.lon_deg, 116.44);
-    EXPECT_DOUBLE_EQ(spec.field.origin.height_m, 50.0);
-    EXPECT_DOUBLE_EQ(spec.field.heading_deg, 90.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.origin.lat_deg, 40.18);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.origin.lon_deg, 116.44);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.origin.height_m, 50.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.heading_deg, 90.0);
 
-    EXPECT_DOUBLE_EQ(spec.vehicle.speed_km_h, 6.0);
-    EXPECT_DOUBLE_EQ(spec.vehicle.accel_m_s2, 0.4);
-    EXPECT_DOUBLE_EQ(spec.vehicle.start_m, -60.0);
-    EXPECT_DOUBLE_EQ(spec.vehicle.overrun_m, 7.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.speed_km_h, 6.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.accel_m_s2, 0.4);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.start_m, -60.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.overrun_m, 7.0);
 
-    EXPECT_DOUBLE_EQ(spec.boom.l1_m, 0.55);
-    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.85);
-    EXPECT_DOUBLE_EQ(spec.boom.l3_m, 0.40);
-    EXPECT_DOUBLE_EQ(spec.boom.linkage_rise_m, 0.6);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l1_m, 0.55);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l2_m, 0.85);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l3_m, 0.40);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.linkage_rise_m, 0.6);
 
-    EXPECT_DOUBLE_EQ(spec.breakpoint.along_m, 2.5);
-    EXPECT_DOUBLE_EQ(spec.breakpoint.button_at_s, 1.5);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).breakpoint.along_m, 2.5);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).breakpoint.button_at_s, 1.5);
 
-    EXPECT_EQ(spec.gnss.talker, GnssTalker::gn);
-    EXPECT_EQ(to_string(spec.gnss.talker), "GN");
-    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 10.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.05);
-    EXPECT_EQ(spec.gnss.fix, GnssFix::rtk_float);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.base_m, 0.01);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.ppm, 2.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.baseline_km, 5.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.horizontal_sigma_m(), 0.02);
-    ASSERT_EQ(spec.gnss.dropouts.size(), 2u);
-    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[0].at_s, 31.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[0].for_s, 0.6);
-    EXPECT_DOUBLE_EQ(spec.gnss.dropouts[1].at_s, 40.0);
-    ASSERT_EQ(spec.gnss.degraded.size(), 1u);
-    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].at_s, 20.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].for_s, 2.0);
-    EXPECT_EQ(spec.gnss.degraded[0].fix, GnssFix::dgps);
-    EXPECT_DOUBLE_EQ(spec.gnss.degraded[0].sigma_m, 0.3);
+    EXPECT_EQ(breakpoint_sections(spec).gnss.talker, GnssTalker::gn);
+    EXPECT_EQ(to_string(breakpoint_sections(spec).gnss.talker), "GN");
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.rate_hz, 10.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.latency_s, 0.05);
+    EXPECT_EQ(breakpoint_sections(spec).gnss.fix, GnssFix::rtk_float);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.base_m, 0.01);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.ppm, 2.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.baseline_km, 5.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.horizontal_sigma_m(), 0.02);
+    ASSERT_EQ(breakpoint_sections(spec).gnss.dropouts.size(), 2u);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.dropouts[0].at_s, 31.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.dropouts[0].for_s, 0.6);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.dropouts[1].at_s, 40.0);
+    ASSERT_EQ(breakpoint_sections(spec).gnss.degraded.size(), 1u);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.degraded[0].at_s, 20.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.degraded[0].for_s, 2.0);
+    EXPECT_EQ(breakpoint_sections(spec).gnss.degraded[0].fix, GnssFix::dgps);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.degraded[0].sigma_m, 0.3);
 
-    EXPECT_EQ(spec.encoder.pulses_per_rev, 2000u);
-    EXPECT_DOUBLE_EQ(spec.encoder.wheel_diameter_m, 0.9);
-    EXPECT_DOUBLE_EQ(spec.encoder.rate_hz, 200.0);
-    EXPECT_DOUBLE_EQ(spec.encoder.slip_pct, 1.5);
-    EXPECT_DOUBLE_EQ(spec.encoder.slip_sd_pct, 0.5);
+    EXPECT_EQ(breakpoint_sections(spec).encoder.pulses_per_rev, 2000u);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.wheel_diameter_m, 0.9);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.rate_hz, 200.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.slip_pct, 1.5);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.slip_sd_pct, 0.5);
 
     EXPECT_EQ(spec.controller.command, (std::vector<std::string>{"rig-controller", "--verbose"}));
     ASSERT_TRUE(spec.controller.params.present);
@@ -209,37 +211,37 @@ TEST(CaseSpec, FullFileParsesToTheWrittenValues) {
 TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     TempDir dir;
     const CaseSpec spec = load_case_file(dir.write("minimal.yaml", kMinimalCase));
-    const CaseSpec defaults;
+    const BreakpointSections defaults;
 
     EXPECT_EQ(spec.name, "minimal");
     EXPECT_EQ(spec.description, "");
     EXPECT_EQ(spec.seed, 1u);
     EXPECT_EQ(spec.mode, RunMode::lockstep);
-    EXPECT_EQ(spec.utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h);
-    EXPECT_DOUBLE_EQ(spec.field.origin.height_m, 0.0);
-    EXPECT_DOUBLE_EQ(spec.vehicle.accel_m_s2, 0.5);
-    EXPECT_DOUBLE_EQ(spec.vehicle.overrun_m, 5.0);
-    EXPECT_DOUBLE_EQ(spec.boom.l1_m, 0.50);
-    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.80);
-    EXPECT_DOUBLE_EQ(spec.boom.l3_m, 0.45);
-    EXPECT_DOUBLE_EQ(spec.boom.linkage_rise_m, 0.50);
-    EXPECT_DOUBLE_EQ(spec.breakpoint.along_m, 0.0);
-    EXPECT_DOUBLE_EQ(spec.breakpoint.button_at_s, 1.0);
-    EXPECT_EQ(spec.gnss.talker, GnssTalker::gp);
-    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 5.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.latency_s, 0.10);  // the Table 3 fit
-    EXPECT_DOUBLE_EQ(spec.encoder.deflection_pct, 3.0);
-    EXPECT_EQ(spec.gnss.fix, GnssFix::rtk_fixed);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.base_m, 0.008);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.ppm, 1.0);
-    EXPECT_DOUBLE_EQ(spec.gnss.noise.baseline_km, 2.0);
-    EXPECT_TRUE(spec.gnss.dropouts.empty());
-    EXPECT_TRUE(spec.gnss.degraded.empty());
-    EXPECT_EQ(spec.encoder.pulses_per_rev, 1000u);
-    EXPECT_DOUBLE_EQ(spec.encoder.wheel_diameter_m, 1.0);
-    EXPECT_DOUBLE_EQ(spec.encoder.rate_hz, 100.0);
-    EXPECT_DOUBLE_EQ(spec.encoder.slip_pct, defaults.encoder.slip_pct);
-    EXPECT_DOUBLE_EQ(spec.encoder.slip_sd_pct, defaults.encoder.slip_sd_pct);
+    EXPECT_EQ(breakpoint_sections(spec).utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.origin.height_m, 0.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.accel_m_s2, 0.5);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.overrun_m, 5.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l1_m, 0.50);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l2_m, 0.80);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l3_m, 0.45);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.linkage_rise_m, 0.50);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).breakpoint.along_m, 0.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).breakpoint.button_at_s, 1.0);
+    EXPECT_EQ(breakpoint_sections(spec).gnss.talker, GnssTalker::gp);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.rate_hz, 5.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.latency_s, 0.10);  // the Table 3 fit
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.deflection_pct, 3.0);
+    EXPECT_EQ(breakpoint_sections(spec).gnss.fix, GnssFix::rtk_fixed);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.base_m, 0.008);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.ppm, 1.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.noise.baseline_km, 2.0);
+    EXPECT_TRUE(breakpoint_sections(spec).gnss.dropouts.empty());
+    EXPECT_TRUE(breakpoint_sections(spec).gnss.degraded.empty());
+    EXPECT_EQ(breakpoint_sections(spec).encoder.pulses_per_rev, 1000u);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.wheel_diameter_m, 1.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.rate_hz, 100.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.slip_pct, defaults.encoder.slip_pct);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).encoder.slip_sd_pct, defaults.encoder.slip_sd_pct);
     EXPECT_TRUE(spec.controller.command.empty());
     EXPECT_FALSE(spec.controller.params.present);
     EXPECT_TRUE(spec.limits.empty());
@@ -247,7 +249,7 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     EXPECT_DOUBLE_EQ(spec.timeouts.node_ack_s, 10.0);
     EXPECT_DOUBLE_EQ(spec.timeouts.case_wall_s, 600.0);
     // An identification case measures only the breakpoint error of the defaults.
-    EXPECT_EQ(spec.scenario, Scenario::breakpoint_identification);
+    EXPECT_EQ(breakpoint_sections(spec).scenario_kind, Scenario::breakpoint_identification);
     EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"breakpoint_error_m", 0.20}}));
 }
 
@@ -276,8 +278,8 @@ static_flow: { spray_on_at_s: 9, spray_for_s: 5 }
 controller: { target_flow_l_min: 24 }
 )",
                                      "static.yaml");
-    EXPECT_DOUBLE_EQ(spec.static_flow.spray_on_at_s, 9.0);
-    EXPECT_DOUBLE_EQ(spec.controller.target_flow_l_min, 24.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).static_flow.spray_on_at_s, 9.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).target_flow_l_min, 24.0);
 }
 
 TEST(CaseSpec, EmptySectionsTakeDefaultsAndDefaultLimitsCanBeExpectedToFail) {
@@ -286,8 +288,8 @@ TEST(CaseSpec, EmptySectionsTakeDefaultsAndDefaultLimitsCanBeExpectedToFail) {
 boom: {}
 expect: { fail: [ breakpoint_error_m ] }
 )"));
-    EXPECT_DOUBLE_EQ(spec.gnss.rate_hz, 5.0);
-    EXPECT_DOUBLE_EQ(spec.boom.l2_m, 0.80);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).gnss.rate_hz, 5.0);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.l2_m, 0.80);
     EXPECT_EQ(spec.expect.fail, (std::vector<std::string>{"breakpoint_error_m"}));
 }
 
@@ -299,8 +301,8 @@ TEST(CaseSpec, SeedsExpectedErrorsAndTheStripAllowances) {
     EXPECT_EQ(spec.seeds, (std::vector<std::uint64_t>{11, 3, 7}));
     EXPECT_EQ(spec.seed, 11u) << "the first of the seeds";
     EXPECT_EQ(spec.expect.error, "topic_role_violation");
-    EXPECT_EQ(spec.deposition.strip_start_allowance_m, 2.5);
-    EXPECT_EQ(spec.deposition.strip_end_allowance_m, 0.5);
+    EXPECT_EQ(breakpoint_sections(spec).deposition.strip_start_allowance_m, 2.5);
+    EXPECT_EQ(breakpoint_sections(spec).deposition.strip_end_allowance_m, 0.5);
     EXPECT_FALSE(spec.source_text.empty());
     // Allowances that leave nothing of a continuation's strip are refused.
     try {
@@ -355,15 +357,6 @@ TEST(CaseSpec, AnExpectationOfTheReferenceControllerIsSetAsideForAnother) {
                                                        ", controller: reference }\ncontroller: { command: [ ./mine ] }\n",
                                                    "explicit.yaml");
     EXPECT_TRUE(applied_expectation(explicit_reference).fail.empty());
-}
-
-TEST(CaseSpec, HarnessCanExtendTheDefaultLimits) {
-    std::map<std::string, double> defaults = kDefaultLimits;
-    defaults["spray_drift_m"] = 0.5;
-    const std::string text = std::string(kMinimalCase) + "expect: { fail: [ spray_drift_m ] }\n";
-    EXPECT_THROW(parse_case(text, "case.yaml"), ConfigError);
-    const CaseSpec spec = parse_case(text, "case.yaml", defaults);
-    EXPECT_EQ(effective_limits(spec, defaults).at("spray_drift_m"), 0.5);
 }
 
 // ------------------------------------------------------------------ broken files
@@ -790,26 +783,29 @@ TEST(CaseSpec, EpisodesOutsideTheCasesTimelineAreRefusedAtTheirKey) {
     EXPECT_NO_THROW(check_case_timeline(spec, 60.0, 40.0));
     struct Change {
         const char* legend;
-        std::function<void(CaseSpec&)> apply;
+        std::function<void(BreakpointSections&)> apply;
         const char* key_path;
         const char* message_part;
     };
     const std::vector<Change> changes = {
-        {"dropout longer than the case", [](CaseSpec& c) { c.gnss.dropouts[0].for_s = 1e5; }, "gnss.dropouts[0].for_s",
+        {"dropout longer than the case", [](BreakpointSections& c) { c.gnss.dropouts[0].for_s = 1e5; }, "gnss.dropouts[0].for_s",
          "longer than the whole case (60 s)"},
-        {"dropout after the end", [](CaseSpec& c) { c.gnss.dropouts[0].at_s = 60; }, "gnss.dropouts[0].at_s",
+        {"dropout after the end", [](BreakpointSections& c) { c.gnss.dropouts[0].at_s = 60; }, "gnss.dropouts[0].at_s",
          "after the case ends"},
-        {"dropout before the start", [](CaseSpec& c) { c.gnss.dropouts[1].before_breakpoint_s = 41; },
+        {"dropout before the start", [](BreakpointSections& c) { c.gnss.dropouts[1].before_breakpoint_s = 41; },
          "gnss.dropouts[1].before_breakpoint_s", "before the case does"},
-        {"degraded episode longer than the case", [](CaseSpec& c) { c.gnss.degraded[0].for_s = 61; },
+        {"degraded episode longer than the case", [](BreakpointSections& c) { c.gnss.degraded[0].for_s = 61; },
          "gnss.degraded[0].for_s", "longer than the whole case"},
-        {"degraded episode after the end", [](CaseSpec& c) { c.gnss.degraded[0].at_s = 1000; },
+        {"degraded episode after the end", [](BreakpointSections& c) { c.gnss.degraded[0].at_s = 1000; },
          "gnss.degraded[0].at_s", "after the case ends"},
     };
     for (const Change& change : changes) {
         SCOPED_TRACE(change.legend);
+        // A copy of the case with its seed-000 sections changed.
+        auto own = std::make_shared<BreakpointSections>(breakpoint_sections(spec));
+        change.apply(*own);
         CaseSpec changed = spec;
-        change.apply(changed);
+        changed.system = own;
         try {
             check_case_timeline(changed, 60.0, 40.0);
             ADD_FAILURE() << "accepted";
@@ -827,7 +823,7 @@ TEST(CaseSpec, EpisodesOutsideTheCasesTimelineAreRefusedAtTheirKey) {
 // The boom's push-rod moves: read as written, each checked at its key, one
 // move at a time, and held to the case's timeline like the GNSS episodes.
 TEST(CaseSpec, BoomLiftsParseAndAreCheckedAtTheirKeys) {
-    EXPECT_TRUE(parse_case(kMinimalCase, "none.yaml").boom.lifts.empty());
+    EXPECT_TRUE(breakpoint_sections(parse_case(kMinimalCase, "none.yaml")).boom.lifts.empty());
     const std::string text = std::string(kMinimalCase) + R"(boom:
   linkage_rise_m: 1.0
   lifts:
@@ -835,12 +831,12 @@ TEST(CaseSpec, BoomLiftsParseAndAreCheckedAtTheirKeys) {
     - { at_s: 30, to_m: 0.4, rate_m_s: 0.1 }
 )";
     const CaseSpec spec = parse_case(text, "lifts.yaml");
-    ASSERT_EQ(spec.boom.lifts.size(), 2u);
-    EXPECT_EQ(spec.boom.lifts[1].at_s, 30.0);
-    EXPECT_EQ(spec.boom.lifts[1].to_m, 0.4);
-    EXPECT_EQ(spec.boom.lifts[1].rate_m_s, 0.1);
-    EXPECT_DOUBLE_EQ(spec.boom.lift_duration_s(0), 20.0);  // 1.0 m down at 50 mm/s
-    EXPECT_DOUBLE_EQ(spec.boom.lift_duration_s(1), 4.0);   // 0.4 m up at 100 mm/s
+    ASSERT_EQ(breakpoint_sections(spec).boom.lifts.size(), 2u);
+    EXPECT_EQ(breakpoint_sections(spec).boom.lifts[1].at_s, 30.0);
+    EXPECT_EQ(breakpoint_sections(spec).boom.lifts[1].to_m, 0.4);
+    EXPECT_EQ(breakpoint_sections(spec).boom.lifts[1].rate_m_s, 0.1);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.lift_duration_s(0), 20.0);  // 1.0 m down at 50 mm/s
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).boom.lift_duration_s(1), 4.0);   // 0.4 m up at 100 mm/s
 
     struct Broken {
         const char* legend;
@@ -887,14 +883,14 @@ TEST(CaseSpec, BoomLiftsParseAndAreCheckedAtTheirKeys) {
 // The operator's throttle steps (Fig. 11's pump flows): read as written, each
 // checked at its key, one ramp at a time.
 TEST(CaseSpec, PumpThrottleStepsParseAndAreCheckedAtTheirKeys) {
-    EXPECT_TRUE(parse_case(kMinimalCase, "none.yaml").hydraulics.pump_throttle.empty());
+    EXPECT_TRUE(breakpoint_sections(parse_case(kMinimalCase, "none.yaml")).hydraulics.pump_throttle.empty());
     const std::string head = std::string(kMinimalCase) + "hydraulics:\n  throttle_ramp_s: 2\n  pump_throttle:\n";
     const CaseSpec spec = parse_case(head + "    - { at_s: 10, flow_l_min: 44.2 }\n    - { at_s: 12, flow_l_min: 57.3 }\n",
                                      "throttle.yaml");
-    ASSERT_EQ(spec.hydraulics.pump_throttle.size(), 2u);
-    EXPECT_EQ(spec.hydraulics.pump_throttle[1].at_s, 12.0);
-    EXPECT_EQ(spec.hydraulics.pump_throttle[1].flow_l_min, 57.3);
-    EXPECT_EQ(spec.hydraulics.throttle_ramp_s, 2.0);
+    ASSERT_EQ(breakpoint_sections(spec).hydraulics.pump_throttle.size(), 2u);
+    EXPECT_EQ(breakpoint_sections(spec).hydraulics.pump_throttle[1].at_s, 12.0);
+    EXPECT_EQ(breakpoint_sections(spec).hydraulics.pump_throttle[1].flow_l_min, 57.3);
+    EXPECT_EQ(breakpoint_sections(spec).hydraulics.throttle_ramp_s, 2.0);
 
     struct Broken {
         const char* legend;
@@ -1167,7 +1163,7 @@ TEST(YamlSection, ClosestSpelling) {
     EXPECT_EQ(closest_spelling("rtk_fixd", fixes), "rtk_fixed");
 }
 
-// `board:` (harness/board_spec.h): a wired board's attach, silence and fail-safe.
+// `board:` (harness/spec/board_spec.h): a wired board's attach, silence and fail-safe.
 TEST(CaseSpec, BoardKeysParseWithDefaultsAndBounds) {
     const CaseSpec defaults = parse_case(std::string(kMinimalCase), "case.yaml");
     EXPECT_EQ(defaults.board.attach_timeout_s, 60.0);
@@ -1197,15 +1193,15 @@ TEST(CaseSpec, BoardKeysParseWithDefaultsAndBounds) {
 // Wire faults (emulators/wire_faults.h): off unless written, percentages in [0, 100].
 TEST(CaseSpec, WireFaultsAreOffByDefaultAndReadAsWritten) {
     const CaseSpec defaults = parse_case(std::string(kMinimalCase), "case.yaml");
-    EXPECT_FALSE(defaults.gnss.wire_faults.any());
+    EXPECT_FALSE(breakpoint_sections(defaults).gnss.wire_faults.any());
     EXPECT_FALSE(defaults.board.line_noise.any());
     const CaseSpec set = parse_case(
         std::string(kMinimalCase) +
             "gnss: { wire_faults: { byte_loss_pct: 0.5, corrupt_checksum_pct: 15, truncate_pct: 25 } }\n",
         "case.yaml");
-    EXPECT_EQ(set.gnss.wire_faults.byte_loss_pct, 0.5);
-    EXPECT_EQ(set.gnss.wire_faults.corrupt_checksum_pct, 15.0);
-    EXPECT_EQ(set.gnss.wire_faults.truncate_pct, 25.0);
+    EXPECT_EQ(breakpoint_sections(set).gnss.wire_faults.byte_loss_pct, 0.5);
+    EXPECT_EQ(breakpoint_sections(set).gnss.wire_faults.corrupt_checksum_pct, 15.0);
+    EXPECT_EQ(breakpoint_sections(set).gnss.wire_faults.truncate_pct, 25.0);
     const std::string wired = "mode: realtime\nwiring: { gnss: serial, board_io: modbus_rtu }\n";
     const CaseSpec noisy = parse_case(
         std::string(kMinimalCase) + wired + "board: { line_noise: { corrupt_response_pct: 2, noise_burst_pct: 1 } }\n",
@@ -1244,7 +1240,8 @@ TEST(CaseSpec, EveryCaseInTheRepositoryLoads) {
         SCOPED_TRACE(file.string());
         try {
             const CaseSpec spec = load_case_file(file);
-            wire_faults = wire_faults || spec.gnss.wire_faults.any() || spec.board.line_noise.any();
+            const auto* own = dynamic_cast<const BreakpointSections*>(spec.system.get());
+            wire_faults = wire_faults || (own != nullptr && own->gnss.wire_faults.any()) || spec.board.line_noise.any();
         } catch (const ConfigError& error) {
             ADD_FAILURE() << error.what();
         }
@@ -1252,7 +1249,7 @@ TEST(CaseSpec, EveryCaseInTheRepositoryLoads) {
     EXPECT_TRUE(wire_faults) << "cases/wire-faults/ is among them";
 }
 
-// `realtime:` (harness/realtime_spec.h): the bound on the rig's own lateness;
+// `realtime:` (harness/spec/realtime_spec.h): the bound on the rig's own lateness;
 // `rig_faults:`: the self-test stall. Real-time cases only.
 TEST(CaseSpec, RealtimeLatenessKeysParseWithDefaultsAndBounds) {
     const std::string realtime = std::string(kMinimalCase) + "mode: realtime\n";

@@ -15,11 +15,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/case_spec.h"
-#include "harness/dds_security_setup.h"
-#include "harness/in_process_controller.h"
-#include "harness/case_runner.h"
-#include "harness/judge.h"
+#include "harness/spec/case_spec.h"
+#include "harness/session/dds_security_setup.h"
+#include "harness/session/in_process_controller.h"
+#include "harness/run/case_runner.h"
+#include "harness/systems/systems.h"
 #include "rig/host/child_process.h"
 #include "rig/host/domain_lease.h"
 #include "rig/runtime/dds_context.h"
@@ -227,7 +227,7 @@ TEST(DdsSecurity, InProcessAndWiredCasesAreRefusedWithTheReason) {
     rig::harness::CaseSpec spec = rig::harness::load_case_file(kCase);
     spec.controller.in_process = true;
     rig::harness::RunOptions options;
-    options.controller_plugin = "rig-controller-plugin.so";
+    options.plugin_dir = ".";
     options.dds_security_dir = "out/security";
     const rig::harness::ControllerPlacement placement = rig::harness::place_controller(spec, options);
     EXPECT_FALSE(placement.plugin.has_value());

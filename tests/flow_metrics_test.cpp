@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "harness/metrics.h"
+#include "harness/systems/breakpoint/breakpoint_metrics.h"
 
 namespace {
 

@@ -2,7 +2,8 @@
 // case names escaped, errors shown, byte-identical across runs, and still
 // written (with the reason in place of the figures) when gnuplot is missing.
 // RIG_SAMPLE_REPORT=FILE keeps a copy of the sample page to look at.
-#include "harness/html_report.h"
+#include "harness/report/html_report.h"
+#include "harness/systems/breakpoint/breakpoint_figures.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -63,8 +64,8 @@ std::vector<DoseSample> dose_with_overlap() {
     return rows;
 }
 
-CaseFigures figures_with_data() {
-    CaseFigures figures;
+BreakpointFigures breakpoint_figures_with_data() {
+    BreakpointFigures figures;
     figures.target_flow_l_min = kTargetFlow;
     figures.breakpoint_along_m = 0.0;
     figures.section_open_command_distance_m = kOpenCommandDistance;
@@ -73,6 +74,14 @@ CaseFigures figures_with_data() {
     figures.areas = {{"operational", -3.45, -1.5}, {"repeated", -1.5, 0.0}, {"continuation", 0.0, 2.25}};
     return figures;
 }
+
+CaseFigures figures_of(BreakpointFigures system) {
+    CaseFigures figures;
+    figures.system = std::make_shared<BreakpointFigures>(std::move(system));
+    return figures;
+}
+
+CaseFigures figures_with_data() { return figures_of(breakpoint_figures_with_data()); }
 
 CaseResult odd_name_case() {
     CaseResult result;
@@ -127,8 +136,9 @@ struct Suite {
 Suite synthetic_suite() {
     Suite suite;
     suite.results = {odd_name_case(), failing_case(), error_case()};
-    CaseFigures slow = figures_with_data();
-    slow.flow = step_response(1.02);
+    BreakpointFigures slow_flow = breakpoint_figures_with_data();
+    slow_flow.flow = step_response(1.02);
+    CaseFigures slow = figures_of(slow_flow);
     slow.jitter = {{"gnss <rs232>", 0.05, 0.4, 1.2}, {"flow meter", 0.02, 0.1, 0.3}};
     suite.figures = {figures_with_data(), slow, CaseFigures{}};
     return suite;
@@ -354,7 +364,8 @@ TEST_F(HtmlReportTest, LongTracesAreThinnedForThePage) {
     suite.results.resize(1);
     suite.figures.resize(1);
     // A minute at 1 kHz, with one spike that must survive the thinning.
-    std::vector<FlowSample>& flow = suite.figures[0].flow;
+    BreakpointFigures long_trace = breakpoint_figures_with_data();
+    std::vector<FlowSample>& flow = long_trace.flow;
     flow.clear();
     for (int i = 0; i <= 60'000; ++i) {
         FlowSample sample;
@@ -364,7 +375,8 @@ TEST_F(HtmlReportTest, LongTracesAreThinnedForThePage) {
         sample.measured_flow_l_min = sample.main_flow_l_min;
         flow.push_back(sample);
     }
-    suite.figures[0].section_open_command_t_s = 30.0;
+    long_trace.section_open_command_t_s = 30.0;
+    suite.figures[0] = figures_of(long_trace);
     const HtmlReport report = render_html_report(suite.results, suite.figures, summarize(suite.results));
     EXPECT_TRUE(report.problems.empty());
     EXPECT_EQ(count(report.html, "<svg"), 4u);

@@ -1,4 +1,4 @@
-// The judge on hand-made traces (harness/judge.h, harness/trace_file.h): a
+// The judge on hand-made traces (harness/judge/judge_trace.h, harness/trace/trace_file.h): a
 // trace written row by row, without DDS or a plant, then read back and judged
 // as `rig judge` does. Each test builds the trace of a controller behaviour the
 // judge must not be fooled by, and checks the verdict names the right metric or
@@ -29,8 +29,12 @@
 #include <nlohmann/json.hpp>
 
 #include "emulators/deposition_grid.h"
-#include "harness/judge.h"
-#include "harness/trace_file.h"
+#include "harness/judge/verdict.h"
+#include "harness/systems/breakpoint/breakpoint_judge.h"
+#include "harness/systems/breakpoint/breakpoint_world.h"
+#include "harness/systems/systems.h"
+#include "harness/trace/topic_roles.h"
+#include "harness/trace/trace_file.h"
 #include "idl/topics.h"
 
 namespace {
@@ -45,8 +49,8 @@ constexpr double kNominal = 20.0 / 60.0 / (6.0 / 3.6 * 12.2) * 100.0;  // 20 L/m
 
 // A continuation at 6 km/h with the breakpoint at 0: the first pass from -25 m,
 // the continuation pass (pass 1) from 30 s, the strip -24..+9 m.
-JudgingPlan continuation_plan() {
-    JudgingPlan plan;
+BreakpointJudgingPlan continuation_plan() {
+    BreakpointJudgingPlan plan;
     plan.scenario = "breakpoint_continuation";
     plan.breakpoint_along_m = 0.0;
     plan.field_origin_lat_deg = 40.18;
@@ -68,7 +72,7 @@ JudgingPlan continuation_plan() {
 // A trace file being written by hand.
 class HandMadeTrace {
 public:
-    HandMadeTrace(const std::string& name, const JudgingPlan& plan)
+    HandMadeTrace(const std::string& name, const BreakpointJudgingPlan& plan)
         : dir_(rig::testing::fresh_dir("judge-" + name)), trace_(dir_ / "trace.sqlite") {
         trace_.set_meta("case", name);
         trace_.set_meta("case_file", "hand-made/" + name + ".yaml");
@@ -113,7 +117,7 @@ public:
     }
     void finish(const TraceOutcome& outcome = TraceOutcome{"completed", "", "", 60 * kS}) {
         grid_.deposit(1, 0, -44.0, 0.0);  // both passes exist in the grid
-        trace_.record_deposition(grid_);
+        record_deposition(trace_, grid_);
         trace_.finish(outcome);
     }
     CaseRun judged() { return judge_trace(read_trace(path())); }
@@ -172,7 +176,7 @@ TEST(Judge, NeverSprayingMissesTheWholeStrip) {
 }
 
 TEST(Judge, FlickeringSectionsNeverSettleAndGetNoSmallAdjustTime) {
-    JudgingPlan plan = continuation_plan();
+    BreakpointJudgingPlan plan = continuation_plan();
     plan.judge_deposition = false;
     HandMadeTrace made("flicker", plan);
     made.drive();
@@ -215,7 +219,7 @@ TEST(Judge, ATruthReaderFailsTheCaseNamingTopicAndParticipant) {
     EXPECT_NE(result.error.find("reads truth topic truth/vehicle"), std::string::npos) << result.error;
     EXPECT_NE(result.error.find("participant 'controller'"), std::string::npos) << result.error;
     // The same trace with the error expected passes as such.
-    JudgingPlan expecting = continuation_plan();
+    BreakpointJudgingPlan expecting = continuation_plan();
     expecting.expect_error = "topic_role_violation";
     HandMadeTrace again("truth-reader-expected", expecting);
     again.trace().record_discoveries(
@@ -227,13 +231,13 @@ TEST(Judge, ATruthReaderFailsTheCaseNamingTopicAndParticipant) {
 }
 
 // A plan whose expectation was set aside (the case ran a controller other than
-// the reference, harness/case_spec.h applied_expectation): the same trace that
+// the reference, harness/spec/case_spec.h applied_expectation): the same trace that
 // passes as an expected error is judged on its own, a failure, and the result
 // says why the expectation did not apply, from the trace alone.
 TEST(Judge, AnExpectationSetAsideIsNotAppliedAndTheResultSaysWhy) {
-    JudgingPlan plan = continuation_plan();
+    BreakpointJudgingPlan plan = continuation_plan();
     plan.expect_set_aside = "the case expects an error, topic_role_violation, of the reference controller; it ran ./mine";
-    const JudgingPlan back = judging_plan_from_json(to_json(plan));
+    const BreakpointJudgingPlan back = breakpoint_judging_plan_from_json(to_json(plan));
     EXPECT_EQ(back.expect_set_aside, plan.expect_set_aside);
     HandMadeTrace made("truth-reader-set-aside", plan);
     made.trace().record_discoveries(
@@ -247,7 +251,7 @@ TEST(Judge, AnExpectationSetAsideIsNotAppliedAndTheResultSaysWhy) {
     // A trace from before the reason existed still reads (no set_aside key).
     nlohmann::json old = to_json(continuation_plan());
     old["expect"].erase("set_aside");
-    EXPECT_EQ(judging_plan_from_json(old).expect_set_aside, "");
+    EXPECT_EQ(breakpoint_judging_plan_from_json(old).expect_set_aside, "");
 }
 
 TEST(Judge, ForgedTruthIsNeverJudgedAndFailsTheCase) {
@@ -271,7 +275,7 @@ TEST(Judge, AKilledControllersTraceKeepsItsSamplesAndItsError) {
     made.finish(TraceOutcome{"error", "node_exited",
                              "node 'controller': process killed by signal 6 (Aborted) (at t=20.000 s)", 20 * kS});
     const RecordedTrace trace = read_trace(made.path());
-    EXPECT_EQ(trace.samples.at(rig::topics::kVehicleTruth).size(), 1201u) << "every sample written is there";
+    EXPECT_EQ(trace.rows.at(rig::topics::kVehicleTruth).size(), 1201u) << "every sample written is there";
     const CaseResult result = judge_trace(trace).result;
     EXPECT_FALSE(case_passed(result));
     EXPECT_EQ(result.error_kind, "node_exited");
@@ -281,7 +285,7 @@ TEST(Judge, AKilledControllersTraceKeepsItsSamplesAndItsError) {
         << result.failures.front();
 }
 
-// A real-time run's facts with the rig's own lateness (harness/case_runner.cpp
+// A real-time run's facts with the rig's own lateness (harness/run/case_runner.cpp
 // lateness_json): `overloaded` non-empty when it passed the case's bound.
 std::string realtime_run_facts(const std::string& overloaded) {
     return nlohmann::json{{"wall_seconds", 61.0},
@@ -476,13 +480,13 @@ TEST(Judge, WhatIsNotATraceIsRefusedNamingIt) {
 }
 
 TEST(JudgingPlan, RoundTripsThroughJsonAndNamesAMissingKey) {
-    const JudgingPlan plan = continuation_plan();
-    const JudgingPlan back = judging_plan_from_json(to_json(plan));
+    const BreakpointJudgingPlan plan = continuation_plan();
+    const BreakpointJudgingPlan back = breakpoint_judging_plan_from_json(to_json(plan));
     EXPECT_EQ(to_json(back), to_json(plan));
     nlohmann::json broken = to_json(plan);
     broken["flow"].erase("window_to_ns");
     try {
-        judging_plan_from_json(broken);
+        breakpoint_judging_plan_from_json(broken);
         ADD_FAILURE() << "accepted a plan without flow.window_to_ns";
     } catch (const std::runtime_error& error) {
         EXPECT_NE(std::string(error.what()).find("flow.window_to_ns"), std::string::npos) << error.what();

@@ -1,4 +1,4 @@
-// MCAP (harness/trace_mcap.h, harness/mcap_writer.h): `rig mcap` writes a run's
+// MCAP (harness/trace/trace_mcap.h, harness/trace/mcap_writer.h): `rig mcap` writes a run's
 // traces as MCAP, and the official reader (@mcap/core, tests/js/, installed by
 // scripts/setup) reads them both ways a tool does, indexed as Foxglove opens a
 // file and streamed with every CRC checked; every sample of the trace, the
@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "harness/mcap_writer.h"
-#include "harness/trace_mcap.h"
+#include "harness/trace/mcap_writer.h"
+#include "harness/trace/trace_mcap.h"
 #include "run_support.h"
 
 namespace fs = std::filesystem;
@@ -171,13 +171,13 @@ TEST(McapCommand, BadInputsAreClearErrors) {
 
     auto result = shell(rig + " mcap " + quoted(not_a_trace));
     EXPECT_EQ(result.exit_code, 1) << result.output;
-    EXPECT_NE(result.output.find("rig mcap: " + not_a_trace.string()), std::string::npos) << result.output;
+    EXPECT_NE(result.output.find("rig mcap: trace " + not_a_trace.string()), std::string::npos) << result.output;
     EXPECT_FALSE(fs::exists(dir / "trace.mcap"));
     EXPECT_FALSE(fs::exists(dir / "trace.mcap.partial"));
 
     result = shell(rig + " mcap " + quoted(dir / "missing.sqlite"));
     EXPECT_EQ(result.exit_code, 1) << result.output;
-    EXPECT_NE(result.output.find("missing.sqlite: not a trace file"), std::string::npos) << result.output;
+    EXPECT_NE(result.output.find("missing.sqlite: no such file"), std::string::npos) << result.output;
 
     result = shell(rig + " mcap " + quoted(dir));  // a directory without cases/*/trace.sqlite
     EXPECT_EQ(result.exit_code, 2) << result.output;

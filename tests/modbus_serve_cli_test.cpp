@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/bench_modbus.h"
+#include "harness/bench/bench_modbus.h"
 #include "rig/wire/modbus_register_map.h"
 #include "modbus_test_support.h"
 #include "rig/host/child_process.h"

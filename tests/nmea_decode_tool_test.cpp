@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "harness/nmea_decode_tool.h"
+#include "harness/bench/nmea_decode_tool.h"
 
 namespace rig::nmea {
 namespace {

@@ -14,8 +14,10 @@
 
 #include "controller/controller_config.h"
 #include "controller/valve_calibration.h"
-#include "harness/board_spec.h"
-#include "harness/case_spec.h"
+#include "harness/spec/board_spec.h"
+#include "harness/spec/case_spec.h"
+#include "harness/systems/breakpoint/breakpoint_case.h"
+#include "harness/systems/systems.h"
 #include "rig/runtime/io_image.h"
 
 namespace {
@@ -68,7 +70,7 @@ void expect_documented(const std::vector<std::vector<std::string>>& rows, const 
 
 TEST(RegisterMapDoc, EveryScalingIsTheCodesConstant) {
     const auto rows = table_rows(read_page());
-    const rig::harness::CaseSpec defaults;
+    const rig::harness::BreakpointSections defaults;
     const rig::controller::ControllerConfig controller;
     expect_documented(rows, "adc_full_scale_counts", rig::io::kAdcFullScale);
     expect_documented(rows, "adc_reference_v", rig::io::kAdcReferenceV);

@@ -1,6 +1,9 @@
 // The results contract (docs/design.md): results.json shape, well-formed escaped
 // JUnit XML, the judge's wording and the expected-failure logic.
-#include "harness/results_writer.h"
+#include "harness/judge/verdict.h"
+#include "harness/output/atomic_file.h"
+#include "harness/output/xml_text.h"
+#include "harness/report/results_writer.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

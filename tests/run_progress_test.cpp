@@ -1,7 +1,7 @@
-// What `rig run` shows while it runs (harness/run_progress.h), without DDS:
+// What `rig run` shows while it runs (harness/run/run_progress.h), without DDS:
 // the status line's wording, the estimate of what is left, the terminal
 // progress's lines and clock, and when colour is wanted (a terminal, no NO_COLOR).
-#include "harness/run_progress.h"
+#include "harness/run/run_progress.h"
 
 #include <gtest/gtest.h>
 #include <pty.h>

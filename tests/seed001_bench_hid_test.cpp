@@ -30,8 +30,9 @@
 #include "controller/boundary/boundary_controller.h"
 #include "controller/boundary/boundary_node_config.h"
 #include "fake_hid_board.h"
-#include "harness/case_runner.h"
-#include "harness/case_spec.h"
+#include "harness/run/case_runner.h"
+#include "harness/spec/case_spec.h"
+#include "harness/systems/systems.h"
 #include "rig/runtime/clock.h"
 #include "rig/runtime/realtime.h"
 #include "rig/wire/serial_port.h"
@@ -93,7 +94,7 @@ std::string port_of(const nlohmann::json& attach, const std::string& role) {
 }
 
 // The Pi, in a process of its own (the rig waits for another process to open
-// the ptys, harness/board_attach.h): the reference logic on the two lines; each
+// the ptys, harness/session/board_attach.h): the reference logic on the two lines; each
 // duty change goes to the parent as "nozzle frequency_hz duty_pct\n" on
 // `duty_fd`, which puts it on the fake board's capture input of that nozzle
 // (nozzle n on input n, docs/hid-io-board.md "Wiring a Raspberry Pi"). Ends
@@ -113,7 +114,10 @@ int pi_main(const fs::path& attach_file, int duty_fd) {
         std::ifstream in(attach_file);
         const nlohmann::json attach = nlohmann::json::parse(in);
         rig::controller::boundary::BoundaryController logic(
-            rig::controller::boundary::load_boundary_node_config(attach_file.parent_path() / "controller.yaml").controller);
+            rig::controller::boundary::load_boundary_node_config(
+                attach_file.parent_path() / "controller.yaml",
+                attach_file.parent_path() / attach.at("job").get<std::string>())
+                .controller);
         rig::SerialPort rmc(port_of(attach, "gnss_nmea"));
         rig::SerialPort laser(port_of(attach, "laser_serial"));
         std::vector<double> driven;

@@ -1,4 +1,4 @@
-// `rig run --shard I/N` and `rig merge` (harness/shard.h, harness/judge_command.h):
+// `rig run --shard I/N` and `rig merge` (harness/run/shard.h, harness/commands/judge_command.h):
 // every case lands in exactly one shard, by its name alone; the shards of a
 // suite, merged, are the suite run at once: the same cases with the same trace
 // digests, metrics and verdicts; merges that cannot be right are refused.
@@ -12,7 +12,7 @@
 #include <set>
 #include <string>
 
-#include "harness/shard.h"
+#include "harness/run/shard.h"
 #include "run_support.h"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// `rig sweep` (harness/sweep.h, issue 15 Monte Carlo): percentiles as numpy's
+// `rig sweep` (harness/report/sweep.h, issue 15 Monte Carlo): percentiles as numpy's
 // default computes them, bands and pass rates from runs whose numbers are
 // known, and the command itself: its runs are the case's own runs (a seed's
 // digest is `rig run --seed`'s), traces kept only as asked, real-time cases
@@ -12,8 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "harness/case_spec.h"
-#include "harness/sweep.h"
+#include "harness/spec/case_spec.h"
+#include "harness/systems/systems.h"
+#include "harness/report/sweep.h"
 #include "run_support.h"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// The trace's JSON text (harness/trace_json.h) is written straight from each
+// The trace's JSON text (harness/trace/trace_json.h) is written straight from each
 // sample, without a JSON object in between. The trace digest is taken over that
 // text, so it must be exactly what nlohmann::json::dump() gives: keys in
 // order, nlohmann's number format (shortest round-trip digits, "1.0",
@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/trace_json.h"
+#include "harness/trace/trace_json.h"
 
 namespace {
 

@@ -15,7 +15,7 @@
 
 #include "controller/valve_calibration.h"
 #include "controller/valve_calibration_procedure.h"
-#include "harness/metrics.h"
+#include "harness/systems/breakpoint/breakpoint_metrics.h"
 #include "run_support.h"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// Seed 001's vision metrics (harness/vision_metrics.h) on hand-made ROIs and
+// Seed 001's vision metrics (harness/systems/boundary/vision_metrics.h) on hand-made ROIs and
 // dose cells with known answers: the coverage model and its fit, Eq. 14's
 // levels as the judge computes them, what counts as a level mismatch, and the
 // worst camera not averaged away by the healthy one. No DDS.
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/vision_metrics.h"
+#include "harness/systems/boundary/vision_metrics.h"
 
 namespace {
 

@@ -14,7 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "harness/judge.h"
+#include "harness/trace/trace_reader.h"
 #include "idl/topics.h"
 #include "run_support.h"
 
@@ -47,9 +47,7 @@ fs::path variant(const fs::path& dir, const std::string& name, const std::string
 }
 
 const std::vector<rig::harness::RecordedSample>& samples(const rig::harness::RecordedTrace& trace, const char* topic) {
-    static const std::vector<rig::harness::RecordedSample> none;
-    const auto it = trace.samples.find(topic);
-    return it == trace.samples.end() ? none : it->second;
+    return trace.samples(topic);
 }
 
 TEST(WireFaultsCase, ReferenceControllerRejectsEveryCorruptSentenceAndOnlyTheBytesChange) {

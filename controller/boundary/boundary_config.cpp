@@ -17,9 +17,14 @@ void in_range(const std::string& key, double value, double lo, double hi, bool l
 }  // namespace
 
 void validate(const BoundaryControllerConfig& c) {
-    if (c.areas.empty()) throw std::invalid_argument("boundary.areas: at least one target area is needed");
-    for (std::size_t i = 0; i < c.areas.size(); ++i) {
-        const TargetAreaConfig& area = c.areas[i];
+    validate_areas(c.areas);
+    validate_settings(c);
+}
+
+void validate_areas(const std::vector<TargetAreaConfig>& areas) {
+    if (areas.empty()) throw std::invalid_argument("boundary.areas: at least one target area is needed");
+    for (std::size_t i = 0; i < areas.size(); ++i) {
+        const TargetAreaConfig& area = areas[i];
         const std::string key = "areas[" + std::to_string(i) + "]";
         if (area.name.empty()) throw std::invalid_argument("boundary." + key + ".name: must not be empty");
         const std::string named = key + " '" + area.name + "'";
@@ -34,6 +39,9 @@ void validate(const BoundaryControllerConfig& c) {
         }
         in_range(named + ".density", area.density, 0.0, 1.0);
     }
+}
+
+void validate_settings(const BoundaryControllerConfig& c) {
     if (c.nozzle_count < 1 || c.nozzle_count > 32) {
         throw std::invalid_argument("boundary.nozzle_count: must be in [1, 32], got " + std::to_string(c.nozzle_count));
     }

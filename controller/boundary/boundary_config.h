@@ -100,5 +100,8 @@ struct BoundaryControllerConfig {
 // Throws std::invalid_argument "boundary.<key>: <what>" for the first value
 // out of its bounds (areas are named as areas[i] 'name').
 void validate(const BoundaryControllerConfig& config);
+// The same in two parts: the target areas (at least one), and everything else.
+void validate_areas(const std::vector<TargetAreaConfig>& areas);
+void validate_settings(const BoundaryControllerConfig& config);
 
 }  // namespace rig::controller::boundary

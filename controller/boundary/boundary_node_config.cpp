@@ -26,11 +26,14 @@ TargetAreaConfig read_area(const YamlSection& s) {
 
 }  // namespace
 
-BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
+namespace {
+
+BoundaryNodeConfig parse_section(const YamlSection& section, const std::optional<BoundaryJob>& job, bool require_areas) {
     BoundaryNodeConfig node;
     BoundaryControllerConfig& c = node.controller;
     section.allow("command");  // the rig's key (kControllerRigKeys)
     for (const YamlSection& area : section.list("areas")) c.areas.push_back(read_area(area));
+    if (c.areas.empty() && job) c.areas = job->areas;
     c.nozzle_count = section.optional_in_range<int>("nozzle_count", c.nozzle_count, Bounds::closed(1, 32));
     read_double(section, "nozzle_spacing_m", c.nozzle_spacing_m);
     read_double(section, "lift_rod_length_m", c.lift_rod_length_m);
@@ -63,6 +66,8 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
     c.faults.ignore_centre_rule = faults.optional<bool>("ignore_centre_rule", false);
 
+    // The cameras on the boom are used unless the section says how (or not).
+    const bool vision_from_job = job && job->cameras && !section.has("vision");
     const YamlSection vision = section.section("vision");
     VisionNodeConfig& v = node.vision;
     v.enabled = vision.optional<bool>("enabled", v.enabled);
@@ -77,6 +82,10 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     v.density_max_age_s = vision.optional_in_range<double>("density_max_age_s", v.density_max_age_s, Bounds::open_closed(0, 60));
     v.calibration_until_s =
         vision.optional_in_range<double>("calibration_until_s", v.calibration_until_s, Bounds::closed(0, 600));
+    if (vision_from_job) {
+        v.enabled = true;
+        v.calibration_until_s = job->calibration_scene_until_s;
+    }
     try {
         vision::validate(v.params);
     } catch (const std::invalid_argument& error) {
@@ -104,15 +113,44 @@ BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section) {
     node.calibration.hold_s = sweep.optional_in_range<double>("hold_s", node.calibration.hold_s, Bounds::open_closed(0, 3600));
     section.finish();
     try {
-        validate(c);
+        if (require_areas || !c.areas.empty()) validate_areas(c.areas);
+        validate_settings(c);
     } catch (const std::invalid_argument& error) {
         section.fail(error.what());
     }
     return node;
 }
 
-BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file) {
-    return parse_boundary_node_config(YamlSection::load_file(file));
+}  // namespace
+
+BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section, const std::optional<BoundaryJob>& job) {
+    return parse_section(section, job, /*require_areas=*/true);
+}
+
+void check_boundary_node_config(const YamlSection& section) { parse_section(section, std::nullopt, /*require_areas=*/false); }
+
+BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file,
+                                             const std::optional<std::filesystem::path>& job_file) {
+    std::optional<BoundaryJob> job;
+    if (job_file) job = load_boundary_job(*job_file);
+    return parse_boundary_node_config(YamlSection::load_file(file), job);
+}
+
+BoundaryJob load_boundary_job(const std::filesystem::path& file) {
+    const YamlSection root = YamlSection::load_file(file);
+    BoundaryJob job;
+    for (const YamlSection& area : root.list("areas")) job.areas.push_back(read_area(area));
+    if (job.areas.empty()) root.fail("areas", "a job names at least one target area");
+    if (root.has("cameras")) {
+        const YamlSection cameras = root.section("cameras");
+        job.cameras = true;
+        job.left_camera_topic = cameras.optional<std::string>("left", "");
+        job.right_camera_topic = cameras.optional<std::string>("right", "");
+        job.calibration_scene_until_s =
+            cameras.optional_in_range<double>("calibration_scene_until_s", 0.0, Bounds::closed(0, 600));
+    }
+    root.finish();
+    return job;
 }
 
 }  // namespace rig::controller::boundary

@@ -6,7 +6,16 @@
 // BoundaryControllerConfig (boundary_config.h), where each is declared once
 // with its unit, default and source; `areas`, `faults` and `calibration` are
 // sections.
+//
+// Beside it the rig gives a seed-001 controller the job (--job FILE,
+// docs/controller-contract.md "The job"): the target areas the operator
+// recorded before work (Sec. 4.2.2) and the cameras on the boom. The job's
+// areas are the controller's when its section names none; with cameras on the
+// boom and no `vision` section, it measures the cover with them (and
+// calibrates from the boards while the job says the scene shows them).
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "controller/boundary/boundary_config.h"
@@ -52,9 +61,29 @@ struct BoundaryNodeConfig {
     VisionNodeConfig vision;
 };
 
+// The job file (job.yaml), as the rig writes it.
+struct BoundaryJob {
+    std::vector<TargetAreaConfig> areas;  // at least one
+    bool cameras = false;  // the two boom cameras publish frames, on these topics:
+    std::string left_camera_topic;
+    std::string right_camera_topic;
+    // While the cameras see Sec. 2.2.1's calibration boards, s from t = 0; 0: never.
+    double calibration_scene_until_s = 0.0;
+};
+// Throws rig::ConfigError naming file, line and key.
+BoundaryJob load_boundary_job(const std::filesystem::path& file);
+
 // Throws rig::ConfigError at the offending key (a bound BoundaryControllerConfig's
-// validate() finds is reported at the section).
-BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section);
-BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file);
+// validate() finds is reported at the section). With a job, what the section
+// does not say is the job's (above); without one, the section alone must name
+// the areas.
+BoundaryNodeConfig parse_boundary_node_config(const YamlSection& section, const std::optional<BoundaryJob>& job = std::nullopt);
+BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file,
+                                             const std::optional<std::filesystem::path>& job_file = std::nullopt);
+
+// The section's own keys and bounds, as `rig-boundary-controller --check-config`
+// checks them before a run: the areas may come from a job, so none is required.
+// Throws rig::ConfigError at the offending key.
+void check_boundary_node_config(const YamlSection& section);
 
 }  // namespace rig::controller::boundary

@@ -1,12 +1,14 @@
 #include "rig/host/child_process.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <optional>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -33,6 +35,16 @@ bool mark_close_on_exec(int max_fd) {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path,
                            const std::vector<std::string>& environment) {
+    start(argv, &log_path, -1, environment);
+}
+
+ChildProcess::ChildProcess(const std::vector<std::string>& argv, int output_fd,
+                           const std::vector<std::string>& environment) {
+    start(argv, nullptr, output_fd, environment);
+}
+
+void ChildProcess::start(const std::vector<std::string>& argv, const std::filesystem::path* log_path, int output_fd,
+                         const std::vector<std::string>& environment) {
     if (argv.empty()) throw std::runtime_error("empty command for a node process");
     for (const auto& arg : argv) command_line_ += (command_line_.empty() ? "" : " ") + arg;
 
@@ -54,7 +66,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
     std::vector<char*> raw_environment;
     for (const auto& entry : child_environment) raw_environment.push_back(const_cast<char*>(entry.c_str()));
     raw_environment.push_back(nullptr);
-    const std::string log = log_path.string();
+    const std::string log = log_path != nullptr ? log_path->string() : std::string();
     const pid_t parent = ::getpid();
     // For kernels without close_range (before 5.11): the fds to mark one by one.
     const long open_max = ::sysconf(_SC_OPEN_MAX);
@@ -84,7 +96,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::file
         // missing program, and the error must say which it was.
         int failure[2] = {static_cast<int>(StartStep::exec), 0};
         const int in = ::open("/dev/null", O_RDONLY);
-        const int out = in < 0 ? -1 : ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int out = in < 0 ? -1 : log_path == nullptr ? output_fd : ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (in < 0) {
             failure[0] = static_cast<int>(StartStep::null_input);
             failure[1] = errno;
@@ -178,6 +190,44 @@ std::string ChildProcess::stop(std::chrono::milliseconds grace) {
     ::waitpid(pid_, &status, 0);
     ended_ = describe_status(status) + " after SIGKILL";
     return *ended_;
+}
+
+CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds time_limit,
+                          std::size_t max_output) {
+    int pipe_fds[2];
+    if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
+        throw std::runtime_error("cannot run '" + (argv.empty() ? std::string() : argv.front()) +
+                                 "': pipe: " + std::strerror(errno));
+    }
+    CommandResult result;
+    std::optional<ChildProcess> child;
+    try {
+        child.emplace(argv, pipe_fds[1]);
+    } catch (...) {
+        ::close(pipe_fds[0]);
+        ::close(pipe_fds[1]);
+        throw;
+    }
+    ::close(pipe_fds[1]);
+    // Read until the child (and anything it started) closes the pipe, or the time is up.
+    const WallStopwatch waited;
+    char buffer[4096];
+    for (;;) {
+        const auto left = time_limit - std::chrono::duration_cast<std::chrono::milliseconds>(waited.elapsed());
+        if (left.count() <= 0) break;
+        pollfd readable{pipe_fds[0], POLLIN, 0};
+        const int ready = ::poll(&readable, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready <= 0) continue;
+        const ssize_t got = ::read(pipe_fds[0], buffer, sizeof buffer);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) break;
+        const std::size_t room = max_output - std::min(max_output, result.output.size());
+        result.output.append(buffer, std::min<std::size_t>(room, static_cast<std::size_t>(got)));
+    }
+    ::close(pipe_fds[0]);
+    result.ended = child->stop(std::chrono::milliseconds(500));
+    return result;
 }
 
 }  // namespace rig

@@ -20,6 +20,9 @@ public:
     // naming the command when it cannot be started.
     ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log_path,
                  const std::vector<std::string>& environment = {});
+    // The same with stdout+stderr to `output_fd` (a pipe's write end: the
+    // caller closes its own copy after the start).
+    ChildProcess(const std::vector<std::string>& argv, int output_fd, const std::vector<std::string>& environment = {});
     ~ChildProcess();  // terminates if still running
     ChildProcess(const ChildProcess&) = delete;
     ChildProcess& operator=(const ChildProcess&) = delete;
@@ -33,10 +36,24 @@ public:
     const std::string& command_line() const { return command_line_; }
 
 private:
+    void start(const std::vector<std::string>& argv, const std::filesystem::path* log_path, int output_fd,
+               const std::vector<std::string>& environment);
     static std::string describe_status(int status);
     pid_t pid_ = -1;
     std::optional<std::string> ended_;
     std::string command_line_;
 };
+
+// What a short command printed and how it ended.
+struct CommandResult {
+    std::string ended;   // "process exited with status 0", "... killed by signal 9 (Killed) after SIGKILL"
+    std::string output;  // its stdout and stderr, interleaved as written (at most max_output bytes)
+    bool succeeded() const { return ended == "process exited with status 0"; }
+};
+// Runs argv to its end, its output captured through a pipe (no file is
+// written), stopped (SIGTERM, then SIGKILL) when it runs past `time_limit`.
+// Throws std::runtime_error naming the command when it cannot be started.
+CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds time_limit,
+                          std::size_t max_output = 64 * 1024);
 
 }  // namespace rig

@@ -15,7 +15,7 @@
 namespace rig {
 
 // A real-time case's `realtime:` section (docs/metrics.md "Verdicts"). Bounds
-// are checked by the case loader (harness/realtime_spec.cpp).
+// are checked by the case loader (harness/spec/realtime_spec.cpp).
 struct LatenessBound {
     // An emission counts as late when it leaves more than this after its
     // deadline; (0, 1000] ms. 10 ms: one period of the device grid (the wheel

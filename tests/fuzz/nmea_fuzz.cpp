@@ -11,7 +11,7 @@
 #include <string_view>
 #include <variant>
 
-#include "harness/nmea_decode_tool.h"
+#include "harness/bench/nmea_decode_tool.h"
 #include "rig/nmea/nmea_parser.h"
 
 namespace {

@@ -1,0 +1,71 @@
+#pragma once
+// `rig judge OUT_DIR|TRACE... [--out NEW_DIR] [--check]`: judges recorded traces
+// again (harness/judge/judge_trace.h, with each trace's system's judge), with today's metric code, and writes the same
+// results contract as `rig run` (results.json, junit.xml, report.txt, report.html).
+//   OUT_DIR   a `rig run --out` directory: every cases/*/trace.sqlite in it, in
+//             the order of its results.json (or by name when there is none)
+//   TRACE     one trace file
+//   --out     where the new results go (nothing is written without it)
+//   --check   compare with OUT_DIR/results.json: every metric bit for bit, what
+//             was not measured, the verdicts, the failures and the digests; any
+//             difference is printed and makes the exit status 1
+// Exit status: 0 when every case passed (and, with --check, nothing differs),
+// 1 otherwise, 2 for bad arguments or a trace that cannot be read.
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "harness/cli/subcommand.h"
+
+namespace rig::harness {
+
+struct JudgeCommandOptions {
+    std::vector<std::string> inputs;
+    std::filesystem::path out_dir;  // empty: print only
+    bool check = false;
+};
+
+int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err);
+
+// `rig merge SHARD_OUT... --out DIR`: the outputs of `rig run --shard I/N`
+// joined into one run directory, as one `rig run` of all the cases would have
+// written it: every shard's cases/NAME/ copied into DIR/cases/, each trace
+// judged again and checked against its shard's results.json (every metric,
+// verdict and digest), then DIR's results.json, junit.xml and reports. A case
+// name found in two shards, a shard without results.json, or a DIR that is not
+// new or empty are refused before anything is written (exit 2). Exit as
+// `rig run`: 1 if a case failed or differs from its shard, 3 if only invalid.
+struct MergeCommandOptions {
+    std::vector<std::string> shard_dirs;
+    std::filesystem::path out_dir;
+};
+int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std::ostream& err);
+
+class JudgeCommand final : public Subcommand {
+public:
+    explicit JudgeCommand(CLI::App& app);
+    JudgeCommand(const JudgeCommand&) = delete;  // CLI11 holds pointers into options_
+    JudgeCommand& operator=(const JudgeCommand&) = delete;
+    bool parsed() const override;
+    int run() override;
+
+private:
+    CLI::App* command_ = nullptr;
+    JudgeCommandOptions options_;
+};
+
+class MergeCommand final : public Subcommand {
+public:
+    explicit MergeCommand(CLI::App& app);
+    MergeCommand(const MergeCommand&) = delete;
+    MergeCommand& operator=(const MergeCommand&) = delete;
+    bool parsed() const override;
+    int run() override;
+
+private:
+    CLI::App* command_ = nullptr;
+    MergeCommandOptions options_;
+};
+
+}  // namespace rig::harness

@@ -1,0 +1,165 @@
+#pragma once
+// A trace file (SQLite; docs/trace-format.md): the rows of a run and the judge's
+// only input. TraceFile writes one; TraceRecorder (harness/trace/trace_recorder.h)
+// feeds it from DDS during a run, and tests write hand-made traces with it to
+// judge them (harness/judge/judge_trace.h) without any DDS.
+//   samples(t_ns, round, topic, json)   every sample, in delivery order
+//   deposition, landing_edges           the spray on the ground (plant truth)
+//   discovery                           endpoints other participants created
+//   foreign_samples                     truth/device samples others wrote (forged)
+//   meta                                the case, the judging plan, the outcome
+// The SHA-256 of the canonical rows ("t_ns round topic json\n" per sample in
+// order, then "deposition pass row nozzle dose\n" per cell and "landing t_ns
+// 0|1\n" per edge) is the trace's digest; `rig judge` recomputes it from the
+// tables. Discovery, forged samples and meta are not part of it (discovery's
+// timing is the machine's, not the simulation's; a forged sample fails the run).
+//
+// Rows are committed in batches as they come (write-ahead log), so a rig killed
+// mid-run leaves a readable file up to the last batch; finish() writes the
+// outcome and the digest into meta and folds the log back into the one file.
+//
+// Samples are written off the lockstep round's critical path: append() queues
+// the row and a writer thread of the file's own serializes it, digests it and
+// inserts it, in the order queued (so the digest is the same). Every other call
+// first waits for the queue to drain, so the file is only ever touched by one
+// thread at a time; all calls come from the thread that runs the case. A write
+// that fails (a full disk) is reported by the next call, naming the file.
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "harness/trace/sha256.h"
+#include "rig/runtime/clock.h"
+#include "rig/runtime/dds_context.h"
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace rig::harness {
+
+// Version of the trace layout (meta key `trace_format`); `rig judge` refuses
+// traces it does not know how to read.
+inline constexpr int kTraceFormat = 2;
+
+// How a case's run ended, for meta (keys `outcome`, `error_kind`, `error`, `end_ns`).
+struct TraceOutcome {
+    std::string status = "completed";  // completed | error | interrupted
+    std::string error_kind;            // rig::FailureKind name when not completed
+    std::string error;                 // what happened, naming the node
+    TimeNs end_ns = 0;                 // the last simulated instant the run reached
+};
+
+// The canonical lines the digest is taken over (TraceFile writes them, the
+// reader recomputes them: harness/trace/trace_reader.h), one per row.
+std::string sample_digest_line(TimeNs t, int round, const std::string& topic, const std::string& json_text);
+std::string deposition_digest_line(int pass, std::size_t row, int nozzle, double dose_ul_cm2);
+std::string landing_digest_line(TimeNs t, bool landing);
+
+// Spray on the ground for the `deposition` table (seed 000's grid along the
+// track, harness/systems/breakpoint): its layout (meta `deposition_grid`) and
+// the non-empty cells, in the order they go into the digest (pass, row, nozzle).
+struct DepositionLayout {
+    double first_row_centre_m = 0.0;
+    double cell_along_m = 0.0;
+    std::size_t rows = 0;
+    int nozzle_count = 0;
+    int passes = 0;
+};
+struct DepositionCell {
+    int pass = 0;
+    std::size_t row = 0;
+    double along_m = 0.0;  // the row's centre
+    int nozzle = 0;
+    double dose_ul_cm2 = 0.0;
+};
+// When spray started (landing) or stopped reaching the ground (Table 1).
+struct LandingEdgeRow {
+    TimeNs t_ns = 0;
+    bool landing = false;
+};
+
+class TraceFile {
+public:
+    // Creates the file (replacing one that is there). Throws std::runtime_error naming it.
+    explicit TraceFile(const std::filesystem::path& file);
+    // A file never finished is committed as "interrupted": what was written stays readable.
+    ~TraceFile();
+    TraceFile(const TraceFile&) = delete;
+    TraceFile& operator=(const TraceFile&) = delete;
+
+    const std::filesystem::path& path() const { return file_; }
+    void set_meta(const std::string& key, const std::string& value);
+    // A sample as JSON text, exactly as nlohmann::json::dump() writes it (the
+    // digest is taken over it; harness/trace/trace_json.h writes it so).
+    void append_text(TimeNs t, int round, const std::string& topic, std::string json_text);
+    // The same from a JSON value (hand-made traces, tests).
+    void append(TimeNs t, int round, const std::string& topic, const nlohmann::json& json) {
+        append_text(t, round, topic, json.dump());
+    }
+    // Text is not a JSON value: it would be stored as one JSON string (append_text takes text).
+    void append(TimeNs t, int round, const std::string& topic, const std::string& json_text) = delete;
+    void append_foreign(TimeNs t, int round, const std::string& topic, const std::string& participant,
+                        const std::string& guid_prefix, const std::string& json_text);
+    void record_discoveries(TimeNs t, const std::vector<DiscoveredEndpoint>& endpoints);
+    void record_deposition(const DepositionLayout& layout, const std::vector<DepositionCell>& cells);
+    void record_landing_edges(const std::vector<LandingEdgeRow>& edges);
+    // Outcome and digest into meta, commit, close; returns the hex SHA-256.
+    // Later calls return the same digest.
+    std::string finish(const TraceOutcome& outcome);
+    bool finished() const { return db_ == nullptr && !sha256_.empty(); }
+    std::uint64_t sample_count() const { return rows_; }
+    // The last instant a sample was appended at (for an unfinished file's end).
+    TimeNs last_t_ns() const { return last_t_ns_; }
+
+private:
+    struct PendingRow {
+        TimeNs t = 0;
+        int round = 0;
+        std::string topic;
+        std::string json_text;
+    };
+    // Records the first SQLite error (see first_error_), then throws it naming the file.
+    [[noreturn]] void fail(const std::string& sqlite_error);
+    void exec(const char* sql);
+    void digest(const std::string& canonical);
+    void write_row(const PendingRow& row);  // on the writer thread
+    void writer_loop();
+    // Until every queued row is written; throws the writer's error, if any.
+    void sync();
+    void stop_writer() noexcept;
+
+    std::filesystem::path file_;
+    sqlite3* db_ = nullptr;
+    sqlite3_stmt* insert_ = nullptr;
+    Sha256 digest_;
+    std::uint64_t rows_ = 0;
+    std::uint64_t rows_in_batch_ = 0;
+    TimeNs last_t_ns_ = 0;
+    std::string digest_text_;  // the digest, once computed (finish may be retried)
+    std::string sha256_;       // set once the file is closed
+
+    // The writer thread and its queue (bounded: a slow disk slows the run down
+    // rather than filling memory).
+    std::mutex queue_mutex_;
+    std::condition_variable queued_;   // rows to write, or stop
+    std::condition_variable drained_;  // the queue emptied, or room in it
+    std::deque<PendingRow> queue_;
+    bool writing_ = false;             // the writer holds rows taken off the queue
+    bool stopping_ = false;
+    bool flush_ = false;               // sync() waits: write whatever is queued
+    std::string writer_error_;
+    // The first SQLite error on either thread, kept for finish(): a write that
+    // failed on the caller's thread (a discovery row on a full disk) is caught
+    // by the run, and without it finish() could only say "a write failed".
+    std::string first_error_;
+    std::thread writer_;
+};
+
+}  // namespace rig::harness

@@ -1,0 +1,2 @@
+// Includes a header that belongs to no room.
+#include "harness/nowhere/lost.h"

@@ -1,0 +1,3 @@
+// Includes a header of a room above its own: the build must refuse it.
+#include "harness/high/high.h"
+int back() { return high(); }
