@@ -1,4 +1,4 @@
-// `rig`: the rig's one command line (README "Running cases", `rig --help`).
+// `rig`: the rig's one command line (docs/running-cases.md, `rig --help`).
 //   rig --version
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N] [--no-pin] [--quiet | --verbose]
 //   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N] [--in-process] [--no-pin]
