@@ -30,7 +30,8 @@ struct SprayCircuitParams {
     // The pipeline's lag without air (hose and boom filling, pressure build-up),
     // s. The paper gives no figure: a fit, with pipeline_air_l, to Table 2's
     // adjust times at the 90 % and 95 % openings; it predicts the 93 % and 94 %
-    // openings it was not fitted on (scripts/fit-pipeline-air, README "Table 2").
+    // openings it was not fitted on (scripts/fit-pipeline-air,
+    // docs/reproduction-seed000.md).
     // Before the air was modelled it was 0.38 s, fitted to Table 2's mean alone.
     double pipeline_time_constant_s = 0.30;
     // Air trapped between the section valves and the nozzle tips (nozzle bodies,

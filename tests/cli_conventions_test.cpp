@@ -1,4 +1,4 @@
-// The `rig` command line's conventions (README "Running cases"), through the
+// The `rig` command line's conventions (docs/running-cases.md), through the
 // built executable:
 //  * `rig --version` prints the version and the commit, exit 0;
 //  * a usage error names the word at fault and exits 2;

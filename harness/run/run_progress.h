@@ -1,5 +1,5 @@
 #pragma once
-// What `rig run` says while cases run (README "Running cases"):
+// What `rig run` says while cases run (docs/running-cases.md "Exit status and progress"):
 //  * CaseLineLog: one line per case as it ends, "rig: [PASS] NAME (1.2 s wall)",
 //    what CI logs and pipes get (and, with --verbose, a line as each starts);
 //  * TerminalProgress: on a terminal, the same lines plus a status line kept

@@ -73,7 +73,7 @@ constexpr std::size_t kMaxQueuedRows = 16384;
 // The writer thread is woken when this many rows wait (or by sync()), not for
 // each round's first row: a wake per round was a thread hand-off per round, a
 // futex wake and two context switches. Woken per 1024 rows, the paper suite in
-// process took 12.4 s of CPU instead of 14.8 s (README "Speed").
+// process took 12.4 s of CPU instead of 14.8 s (docs/speed.md).
 constexpr std::size_t kRowsPerWake = 1024;
 
 }  // namespace

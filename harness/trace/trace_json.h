@@ -4,7 +4,7 @@
 //
 // Written as text straight from the sample, with no JSON object in between:
 // building, dumping and freeing an nlohmann::json per sample cost the paper
-// suite in process about 1.2 s of its 12.4 s of CPU (README "Speed"). The
+// suite in process about 1.2 s of its 12.4 s of CPU (docs/speed.md). The
 // text is byte for byte what
 // nlohmann::json::dump() gives for the same object (keys sorted, its number
 // format, its escapes), because the trace digest is taken over it:

@@ -1,5 +1,5 @@
 #pragma once
-// One CPU for a lockstep case (README "Speed"). A lockstep round is a chain of
+// One CPU for a lockstep case (docs/speed.md). A lockstep round is a chain of
 // hand-offs: the rig's thread writes the devices' samples and the tick, Fast
 // DDS's receiving thread in the controller's process takes them and wakes the
 // controller's thread, which answers through the rig's receiving thread to the
@@ -10,7 +10,7 @@
 // preempts its waker while the waker still holds the lock it wants. On one CPU,
 // with SCHED_BATCH (no wake-up preemption: the woken thread runs when the
 // waker blocks), a hand-off is a plain context switch. Measured with `rig
-// bench` and the paper suite (README "Speed").
+// bench` and the paper suite (docs/speed.md).
 //
 // A lease is an flock() on /tmp/rig-cpu-N.lock, held while the case runs, so
 // that concurrent cases (--jobs, parallel ctest, two rig runs) take different

@@ -46,8 +46,8 @@ namespace {
 // max_samples). Samples are lost when a UDP datagram is, or when a
 // shared-memory port or segment is full; in lockstep a loss is a slower round,
 // never a different trace. `rig bench` before / after, same run: process mode
-// 169.9 -> 100.4 us a round, the ping-pong floor 97.7 -> 63.8 us (README
-// "Speed").
+// 169.9 -> 100.4 us a round, the ping-pong floor 97.7 -> 63.8 us
+// (docs/speed.md).
 //
 // `prompt_repair` keeps the timers the project had before (heartbeat 0.2 ms,
 // no suppression, an immediate acknack): real-time runs, where a device

@@ -14,7 +14,7 @@
 //            published. Counting at the reader gives the guarantee a writer's
 //            wait_for_acknowledgments gives (every sample published at t is in
 //            its readers before they step), minus one handshake per writer per
-//            instant, which was 45 % of a case's wall time (rig/README note).
+//            instant, which was 45 % of a case's wall time (docs/design.md "Time").
 //   round r>0: while the previous round published anything, nodes with unread
 //            input run again at the same t. A sample published at t is therefore
 //            seen by its readers at t; delays come only from the models.

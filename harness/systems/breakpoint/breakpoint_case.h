@@ -144,8 +144,8 @@ struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
     double rate_hz = 5.0;      // [1, 20]; the G970II runs at 5 Hz
     // [0, 1): fix epoch -> the epoch's last sentence complete at the controller.
-    // A fit, with EncoderSpec::deflection_pct, to Table 3 (README "Every fitted
-    // parameter"): a receiver's own output delay plus about 150 bytes of GGA+RMC.
+    // A fit, with EncoderSpec::deflection_pct, to Table 3 (docs/reproduction-seed000.md
+    // "Every fitted parameter"): a receiver's own output delay plus about 150 bytes of GGA+RMC.
     double latency_s = 0.10;
     // Receiver epochs fall at epoch_phase_s + k / rate_hz of simulated time. The
     // receiver's epoch grid has nothing to do with where the sprayer is, so when
