@@ -2,6 +2,7 @@
 #   lib/librig_node.a, lib/librig_idl.a, lib/librig_nmea.a   rig::node, rig::idl, rig::nmea
 #   include/rig/runtime/*.h                                  the runtime's headers
 #   include/rig/nmea/*.h                                     the NMEA parser and encoder
+#   include/rig/papers/*.h                                   each seed's paper's shared numbers
 #   include/rig/idl/*.h                                      generated topic types, msg_traits.h, topics.h
 #   share/rig/idl/*.idl, share/rig/idl/topics.json           the types and the topic table for other languages
 #   share/rig/docs/*.md                                      the controller contract
@@ -18,6 +19,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/runtime/ DESTINATION ${CMAKE_INSTALL
         FILES_MATCHING PATTERN "*.h")
 install(FILES ${PROJECT_BINARY_DIR}/include/rig/runtime/version.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/nmea/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/nmea
+        FILES_MATCHING PATTERN "*.h")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/rig/papers/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/papers
         FILES_MATCHING PATTERN "*.h")
 install(FILES ${RIG_IDL_GENERATED_HEADERS} ${PROJECT_SOURCE_DIR}/idl/msg_traits.h ${PROJECT_SOURCE_DIR}/idl/topics.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/rig/idl)

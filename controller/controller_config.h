@@ -11,6 +11,7 @@
 #include "controller/valve_calibration.h"
 #include "controller/valve_calibration_procedure.h"
 #include "controller/valve_driver.h"
+#include "rig/papers/seed000.h"
 
 namespace rig {
 class YamlSection;
@@ -61,13 +62,13 @@ struct ControllerConfig {
     Positioning positioning = Positioning::fusion;
     double threshold_m = 5.0;              // odometer takes over inside this (sec. 3.2.1)
     // Boom geometry the controller believes (Eq. 6); the plant has its own truth.
-    double l1_m = 0.50;
-    double l2_m = 0.80;
-    double l3_m = 0.45;
-    double linkage_rise_m = 0.50;
+    double l1_m = papers::seed000::kL1M;
+    double l2_m = papers::seed000::kL2M;
+    double l3_m = papers::seed000::kL3M;
+    double linkage_rise_m = papers::seed000::kLinkageRiseM;
     // Land-wheel odometer (Eq. 5).
-    double wheel_diameter_m = 1.0;
-    std::uint32_t pulses_per_rev = 1000;
+    double wheel_diameter_m = papers::seed000::kLandWheelDiameterM;
+    std::uint32_t pulses_per_rev = papers::seed000::kEncoderPulsesPerRev;
     double speed_window_s = 0.2;           // t1 of Eq. 5
     double gnss_latency_compensation_s = 0.0;
     // GGA quality is a code, not a scale (4 RTK fixed, 5 RTK float, 2 DGPS, 1 GPS):
@@ -109,14 +110,14 @@ struct ControllerConfig {
     double on_target_band_pct = 3.0;
     double on_target_hold_s = 0.5;
     // Eq. 3 on the KF11 (90 pulses/L), measured over a sliding window (controller/flow_rate_meter.h).
-    double flow_meter_pulses_per_l = 90.0;
+    double flow_meter_pulses_per_l = papers::seed000::kFlowMeterPulsesPerLitre;
     double flow_window_s = 0.25;
     // Eq. 8: pump-outlet sensor range Q_F and the converter's voltage span u.
-    double pump_sensor_full_scale_m3_h = 8.0;  // WL-LWGA-20: 0.8-8 m^3/h
+    double pump_sensor_full_scale_m3_h = papers::seed000::kPumpSensorFullScaleM3H;
     double pump_sensor_span_v = 3.3;
     double pump_flow_smoothing_s = 0.5;     // the plunger pump pulsates; average before use
     // Pull-wire boom-height sensor: h at full span (Eq. 6 uses h).
-    double boom_height_range_m = 1.0;
+    double boom_height_range_m = papers::seed000::kBoomHeightRangeM;
     double boom_height_span_v = 3.3;
     ValveDriverParams valve{};
     std::vector<CalibratedOpening> calibration = default_calibration();

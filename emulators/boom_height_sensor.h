@@ -9,11 +9,12 @@
 #include "emulators/plant.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
+#include "rig/papers/seed000.h"
 
 namespace rig::emulators {
 
 struct BoomHeightSensorParams {
-    double range_m = 1.0;      // h at 3.3 V
+    double range_m = papers::seed000::kBoomHeightRangeM;  // h at 3.3 V
     double rate_hz = 10.0;
 };
 

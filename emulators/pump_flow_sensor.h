@@ -16,11 +16,12 @@
 #include "emulators/spray_circuit.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
+#include "rig/papers/seed000.h"
 
 namespace rig::emulators {
 
 struct PumpFlowSensorParams {
-    double full_scale_m3_h = 8.0;   // Q_F: the paper's WL-LWGA-20 turbine reads 0.8-8 m^3/h (133 L/min)
+    double full_scale_m3_h = papers::seed000::kPumpSensorFullScaleM3H;   // Q_F of Eq. 8 (133 L/min)
     double noise_mv = 2.0;
     double offset_ma = 0.0;
     double rate_hz = 20.0;

@@ -35,11 +35,12 @@
 
 #include "emulators/field2d/nozzle_flow_table.h"
 #include "rig/runtime/clock.h"
+#include "rig/papers/seed001.h"
 
 namespace rig::emulators {
 
 struct PwmValveParams {
-    double frequency_hz = 9.0;          // (0, 1000]; Sec. 3.2.1
+    double frequency_hz = papers::seed001::kPwmFrequencyHz;  // (0, 1000]
     double response_s = 0.015;          // [0, half a period); Table 1: 10-20 ms
     std::optional<double> pwm_phase_s;  // [0, period); unset: drawn from the seed
     bool latch_at_period_start = true;  // assumed, see above

@@ -34,6 +34,7 @@
 #include <cstddef>
 #include <variant>
 #include <vector>
+#include "rig/papers/seed000.h"
 
 namespace rig::emulators {
 
@@ -44,10 +45,10 @@ namespace rig::emulators {
 // on purpose independently of the controller's Eq. 6 function, so that a case
 // can give the controller a wrong belief about the boom.
 struct BoomGeometry {
-    double l1_m = 0.50;
-    double l2_m = 0.80;
-    double l3_m = 0.45;
-    double linkage_rise_m = 0.50;
+    double l1_m = papers::seed000::kL1M;
+    double l2_m = papers::seed000::kL2M;
+    double l3_m = papers::seed000::kL3M;
+    double linkage_rise_m = papers::seed000::kLinkageRiseM;
     // L4 = L1 + cos(atan(h / L2)) L2 + L3 (Eq. 6): antenna to nozzle line, along the heading.
     double l4_m() const;
 };

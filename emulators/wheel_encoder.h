@@ -19,12 +19,13 @@
 #include <string>
 
 #include "emulators/plant.h"
+#include "rig/papers/seed000.h"
 
 namespace rig::emulators {
 
 struct WheelEncoderParams {
-    std::uint32_t pulses_per_rev = 1000;
-    double wheel_diameter_m = 1.0;
+    std::uint32_t pulses_per_rev = papers::seed000::kEncoderPulsesPerRev;
+    double wheel_diameter_m = papers::seed000::kLandWheelDiameterM;
     double rate_hz = 100.0;
 };
 

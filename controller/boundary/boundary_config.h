@@ -8,6 +8,7 @@
 // Machine Vision and Beidou Positioning", Trans. CSAM 2022, 53(7).
 #include <string>
 #include <vector>
+#include "rig/papers/seed001.h"
 
 namespace rig::controller::boundary {
 
@@ -51,15 +52,15 @@ struct BoundaryControllerConfig {
     std::vector<TargetAreaConfig> areas;  // >= 1; the UTM zone is that of the corners' mean
 
     // Boom (Table 1, Sec. 5.1): nozzles numbered 0.. left to right facing travel (assumed).
-    int nozzle_count = 6;                 // [1, 32]; Sec. 5.1
-    double nozzle_spacing_m = 0.50;       // (0, 5]; Table 1
+    int nozzle_count = papers::seed001::kNozzleCount;                 // [1, 32]
+    double nozzle_spacing_m = papers::seed001::kNozzleSpacingM;       // (0, 5]
     // Eq. 18, the controller's belief of the lift (the plant has its own truth).
     // The paper gives none of these: assumed, boom centre 1.00 m ahead of the
     // antenna at H = 0.5 m (see emulators/field2d/boom_lift.h).
-    double lift_rod_length_m = 0.50;      // I, (0, 5]
-    double lift_hinge_height_m = 0.80;    // Hp, (0, 5]
-    double antenna_to_o_m = 0.30;         // M, [-10, 10]
-    double hinge_to_boom_centre_m = 0.90; // L, [-10, 10]
+    double lift_rod_length_m = papers::seed001::kLiftRodLengthM;      // I, (0, 5]
+    double lift_hinge_height_m = papers::seed001::kLiftHingeHeightM;  // Hp, (0, 5]
+    double antenna_to_o_m = papers::seed001::kLiftAntennaToOM;        // M, [-10, 10]
+    double hinge_to_boom_centre_m = papers::seed001::kLiftHingeToBoomCentreM;  // L, [-10, 10]
     double boom_centre_right_of_antenna_m = 0.0;  // [-5, 5]; Sec. 1.1: antenna on the centre line
 
     // L4 laser (Sec. 1.1): H = D - laser_mount_offset_m.
@@ -67,16 +68,15 @@ struct BoundaryControllerConfig {
     double default_boom_height_m = 0.50;  // within the lift's reach; Sec. 5.1, used until the first reading
 
     // Eq. 9-14: q = eq12 D v / k (L/min), s = (q - b) / A (%), levels.
-    double k_max_cover = 0.78;            // (0, 1]; k, not given: 0.78 puts the paper's 40 % sparse/normal split on the level 1/2 boundary at 1.5 m/s (assumed)
-    double eq12_coefficient_l_min_per_m_s = 0.40968;    // (0, 10]; Eq. 12 = 0.01138 L/m^2 (Eq. 9) x 60 s/min x 0.6 m
-    double eq13_slope_l_min_per_pct = 0.00375;  // A, (0, 1]; Eq. 13 (Table 3 fit)
-    double eq13_intercept_l_min = 0.296;  // b, [-10, 10]; Eq. 13
-    double level0_max_pct = -55.0;        // s <= this: level 0, valve closed. Sec. 3.2.2 prints -69 %, but its
-                                          // own "15 % of full flow" gives -55 % (Eq. 13): -69 is a typo
-    double level1_max_pct = 5.0;          // > level0_max_pct; level 1 up to here (Sec. 3.2.2)
-    double level1_duty_pct = 40.0;        // [0, 100]; Sec. 3.2.2
-    double level2_duty_pct = 100.0;       // [0, 100]; Sec. 3.2.2
-    double pwm_frequency_hz = 9.0;        // (0, 1000]; Sec. 3.2.1
+    double k_max_cover = papers::seed001::kEq14MaxCover;  // (0, 1]
+    double eq12_coefficient_l_min_per_m_s = papers::seed001::kEq12CoefficientLMinPerMS;  // (0, 10]
+    double eq13_slope_l_min_per_pct = papers::seed001::kEq13SlopeLMinPerPct;  // A, (0, 1]
+    double eq13_intercept_l_min = papers::seed001::kEq13InterceptLMin;  // b, [-10, 10]
+    double level0_max_pct = papers::seed001::kLevel0MaxPct;  // s <= this: level 0, valve closed
+    double level1_max_pct = papers::seed001::kLevel1MaxPct;  // > level0_max_pct; level 1 up to here
+    double level1_duty_pct = papers::seed001::kLevel1DutyPct;  // [0, 100]
+    double level2_duty_pct = papers::seed001::kLevel2DutyPct;  // [0, 100]
+    double pwm_frequency_hz = papers::seed001::kPwmFrequencyHz;  // (0, 1000]
 
     // AgOpenGPS-style anticipation (not in the paper, off by default): a nozzle
     // (and the boom-centre rule) switches on when its point lookahead_on_s ahead

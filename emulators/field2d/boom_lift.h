@@ -16,14 +16,15 @@
 // At H = 0.40 m: sqrt(0.25 - 0.16) + 0.60 = 0.90 m; at 0.60 m: 1.058 m.
 #include <string>
 #include <vector>
+#include "rig/papers/seed001.h"
 
 namespace rig::field2d {
 
 struct ParallelogramLift {
-    double rod_length_m = 0.50;              // I, > 0; assumed (paper gives none)
-    double hinge_height_m = 0.80;            // Hp, > 0; assumed
-    double antenna_to_o_m = 0.30;            // M, finite; assumed
-    double hinge_to_boom_centre_m = 0.90;    // L, finite; assumed
+    double rod_length_m = papers::seed001::kLiftRodLengthM;                   // I, > 0
+    double hinge_height_m = papers::seed001::kLiftHingeHeightM;               // Hp, > 0
+    double antenna_to_o_m = papers::seed001::kLiftAntennaToOM;                // M, finite
+    double hinge_to_boom_centre_m = papers::seed001::kLiftHingeToBoomCentreM;  // L, finite
     // Lowest and highest boom height the rods reach: Hp -+ I (rods vertical).
     double min_height_m() const { return hinge_height_m - rod_length_m; }
     double max_height_m() const { return hinge_height_m + rod_length_m; }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "emulators/field2d/vec2.h"
+#include "rig/papers/seed001.h"
 
 namespace rig::field2d {
 
@@ -29,7 +30,7 @@ struct DepositionGrid2dParams {
     double east_max_m = 10.0;
     double north_max_m = 10.0;
     double cell_m = 0.02;         // (0, 1]; 2 cm: a wet edge is located to within a cell
-    int nozzle_count = 6;         // 1..32
+    int nozzle_count = papers::seed001::kNozzleCount;  // 1..32
     // Guard against a grid that would not fit in memory (8 bytes per cell and nozzle).
     std::size_t max_cells_total = 40'000'000;
 };

@@ -18,6 +18,7 @@
 #include "emulators/field2d/local_frame.h"
 #include "emulators/field2d/route2d.h"
 #include "emulators/field2d/vec2.h"
+#include "rig/papers/seed001.h"
 
 namespace rig::field2d {
 
@@ -29,8 +30,8 @@ struct SprayerMounting {
     double antenna_right_m = 0.0;              // finite; Sec. 1.1: on the vehicle's centre line
     double antenna_height_m = 1.70;            // > 0; Sec. 1.1: H1 about 170 cm
     ParallelogramLift lift{};                  // Eq. 18 (assumed lengths, see boom_lift.h)
-    int nozzle_count = 6;                      // 1..32; Sec. 5.1, Table 3
-    double nozzle_spacing_m = 0.50;            // > 0; Table 1
+    int nozzle_count = papers::seed001::kNozzleCount;             // 1..32
+    double nozzle_spacing_m = papers::seed001::kNozzleSpacingM;   // > 0
 };
 
 // Throws std::invalid_argument naming the field.

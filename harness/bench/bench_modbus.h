@@ -17,6 +17,7 @@
 #include "rig/runtime/io_image.h"
 
 #include "harness/cli/subcommand.h"
+#include "rig/papers/seed000.h"
 
 namespace rig::harness {
 
@@ -33,10 +34,10 @@ struct ModbusServeOptions {
 
     // Synthetic board inputs (seed 000: Eq. 5 land wheel, Eq. 3 flow meter).
     double speed_km_h = 0.0;
-    double wheel_diameter_m = 1.0;
-    double pulses_per_rev = 1000.0;
+    double wheel_diameter_m = papers::seed000::kLandWheelDiameterM;
+    double pulses_per_rev = papers::seed000::kEncoderPulsesPerRev;
     double flow_l_min = 0.0;
-    double pulses_per_l = 90.0;
+    double pulses_per_l = papers::seed000::kFlowMeterPulsesPerLitre;
     int pump_flow_adc = 0;
     int boom_height_adc = 0;
     bool spray_switch = false;

@@ -21,6 +21,7 @@
 #include "harness/judge/judge_trace.h"
 #include "harness/judge/metric_set.h"
 #include "harness/trace/trace_reader.h"
+#include "rig/papers/seed001.h"
 #include "harness/systems/boundary/vision_metrics.h"
 
 namespace rig::harness {
@@ -38,7 +39,7 @@ struct BoundaryJudgingPlan {
     std::vector<BoundaryEdgePlan> edges;
     bool flow_per_duty = false;
     double flow_settle_s = 0.5;
-    double pwm_period_s = 1.0 / 9.0;
+    double pwm_period_s = 1.0 / papers::seed001::kPwmFrequencyHz;
     std::vector<std::vector<field2d::FlowPoint>> flow_table;  // what the plant was given (Table 3)
     bool centre_rule = false;
     std::vector<field2d::Vec2> area;       // local frame, counter-clockwise; the centre rule's area

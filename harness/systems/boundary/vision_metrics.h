@@ -32,6 +32,7 @@
 #include <optional>
 #include <string>
 #include <vector>
+#include "rig/papers/seed001.h"
 
 namespace rig::harness {
 
@@ -50,18 +51,17 @@ struct CoverageModel {
 // Coverage (0..1) of a dose in uL/cm^2 (>= 0; a negative or NaN dose throws).
 double paper_coverage(const CoverageModel& model, double dose_ul_cm2);
 
-// The judge's Eq. 14 (Sec. 3.2.2): the paper's constants. k is not given by
-// the paper; 0.78 (the reference controller's assumed value, which puts the
-// 40 % sparse/normal split on the level 1/2 boundary at 1.5 m/s).
+// The judge's Eq. 14 (Sec. 3.2.2), from the paper's constants
+// (rig/papers/seed001.h, where k's assumed value is explained).
 struct Eq14Levels {
-    double k_max_cover = 0.78;                      // (0, 1]
-    double eq12_coefficient_l_min_per_m_s = 0.40968;
-    double eq13_slope_l_min_per_pct = 0.00375;
-    double eq13_intercept_l_min = 0.296;
-    double level0_max_pct = -55.0;
-    double level1_max_pct = 5.0;
-    double level1_duty_pct = 40.0;
-    double level2_duty_pct = 100.0;
+    double k_max_cover = papers::seed001::kEq14MaxCover;  // (0, 1]
+    double eq12_coefficient_l_min_per_m_s = papers::seed001::kEq12CoefficientLMinPerMS;
+    double eq13_slope_l_min_per_pct = papers::seed001::kEq13SlopeLMinPerPct;
+    double eq13_intercept_l_min = papers::seed001::kEq13InterceptLMin;
+    double level0_max_pct = papers::seed001::kLevel0MaxPct;
+    double level1_max_pct = papers::seed001::kLevel1MaxPct;
+    double level1_duty_pct = papers::seed001::kLevel1DutyPct;
+    double level2_duty_pct = papers::seed001::kLevel2DutyPct;
 };
 int eq14_level(const Eq14Levels& eq, double density, double speed_m_s);
 double eq14_level_duty_pct(const Eq14Levels& eq, int level);

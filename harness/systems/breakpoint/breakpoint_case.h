@@ -5,9 +5,12 @@
 // The loader (harness/spec/case_spec.h) reads the sections every case has and
 // hands the rest to read_breakpoint_sections() here.
 //
-// Values not given in the file take the defaults written here (from Li et al.
-// 2023, Agriculture 13, 2203, where the paper has a number), or the emulator's
-// own where the emulator declares the parameter (hydraulics: kCircuitDefaults).
+// A device's parameter takes its default from the device's emulator, where it
+// is declared once with its unit and provenance (emulators/*.h; the numbers the
+// plant, the controller and the judge share from Li et al. 2023 are in
+// rig/papers/seed000.h): these structs only name the keys. Where a case's
+// default differs from the emulator's on purpose (a value fitted to a table
+// against the emulator's ideal device), the key says so.
 #include <chrono>
 #include <cstdint>
 #include <map>
@@ -17,7 +20,14 @@
 #include <string_view>
 #include <vector>
 
+#include "emulators/boom_height_sensor.h"
+#include "emulators/flow_meter_kf11.h"
+#include "emulators/gnss_g970.h"
+#include "emulators/land_wheel.h"
+#include "emulators/pump_flow_sensor.h"
 #include "emulators/spray_circuit_params.h"
+#include "emulators/vehicle_plant.h"
+#include "emulators/wheel_encoder.h"
 #include "harness/spec/case_spec.h"
 
 namespace rig::harness {
@@ -85,11 +95,12 @@ struct BoomLiftSpec {
     SourceLocation to_location;
 };
 
+inline const emulators::BoomGeometry kBoomDefaults{};
 struct BoomSpec {
-    double l1_m = 0.50;
-    double l2_m = 0.80;
-    double l3_m = 0.45;
-    double linkage_rise_m = 0.50;  // h in Eq. 6 at t = 0
+    double l1_m = kBoomDefaults.l1_m;
+    double l2_m = kBoomDefaults.l2_m;
+    double l3_m = kBoomDefaults.l3_m;
+    double linkage_rise_m = kBoomDefaults.linkage_rise_m;  // h in Eq. 6 at t = 0
     std::vector<BoomLiftSpec> lifts;  // `boom.lifts`, none by default: h stays
     // How long lift `index` takes from the h the previous one left.
     double lift_duration_s(std::size_t index) const;
@@ -100,10 +111,11 @@ struct BreakpointSpec {
     double button_at_s = 1.0;  // vehicle stands with the nozzle line at along_m; button pressed then, (0, 600]
 };
 
+inline const emulators::G970Params kG970Defaults{};
 struct GnssNoiseSpec {
-    double base_m = 0.008;  // RTK 8 mm + 1 ppm (paper); [0, 100]
-    double ppm = 1.0;       // [0, 100]
-    double baseline_km = 2.0;  // [0, 200]
+    double base_m = kG970Defaults.noise_base_m;     // [0, 100]
+    double ppm = kG970Defaults.noise_ppm;           // [0, 100]
+    double baseline_km = kG970Defaults.baseline_km;  // [0, 200]
     // 1-sigma horizontal error: base + ppm * baseline.
     double horizontal_sigma_m() const { return base_m + ppm * 1e-6 * baseline_km * 1000.0; }
 };
@@ -142,10 +154,11 @@ struct GnssWireFaultsSpec {
 
 struct GnssSpec {
     GnssTalker talker = GnssTalker::gp;
-    double rate_hz = 5.0;      // [1, 20]; the G970II runs at 5 Hz
+    double rate_hz = kG970Defaults.rate_hz;  // [1, 20]
     // [0, 1): fix epoch -> the epoch's last sentence complete at the controller.
-    // A fit, with EncoderSpec::deflection_pct, to Table 3 (docs/reproduction-seed000.md
-    // "Every fitted parameter"): a receiver's own output delay plus about 150 bytes of GGA+RMC.
+    // Not the emulator's 0.02 s: a fit, with EncoderSpec::deflection_pct, to
+    // Table 3 (docs/reproduction-seed000.md "Every fitted parameter"): a
+    // receiver's own output delay plus about 150 bytes of GGA+RMC.
     double latency_s = 0.10;
     // Receiver epochs fall at epoch_phase_s + k / rate_hz of simulated time. The
     // receiver's epoch grid has nothing to do with where the sprayer is, so when
@@ -159,17 +172,19 @@ struct GnssSpec {
     GnssWireFaultsSpec wire_faults;
 };
 
+inline const emulators::WheelEncoderParams kEncoderDefaults{};
+inline const emulators::LandWheelParams kLandWheelDefaults{};
 struct EncoderSpec {
-    std::uint32_t pulses_per_rev = 1000;  // [1, 100000]; the paper's ZSP5208 has 1000 p/r
-    double wheel_diameter_m = 1.0;        // [0.1, 3] (not given in the paper)
-    double rate_hz = 100.0;               // count publication rate, [1, 1000]
-    double slip_pct = 0.0;                // mean wheel slip, [-20, 20]; ideal wheel unless the case says so
-    double slip_sd_pct = 0.0;             // per-run random slip spread (seeded), [0, 10]
+    std::uint32_t pulses_per_rev = kEncoderDefaults.pulses_per_rev;  // [1, 100000]
+    double wheel_diameter_m = kEncoderDefaults.wheel_diameter_m;     // [0.1, 3]
+    double rate_hz = kEncoderDefaults.rate_hz;                       // count publication rate, [1, 1000]
+    double slip_pct = kLandWheelDefaults.slip_pct;        // mean wheel slip, [-20, 20]
+    double slip_sd_pct = kLandWheelDefaults.slip_sd_pct;  // per-run random slip spread (seeded), [0, 10]
     // Loaded tyre: rolling radius below nominal, [0, 20) (emulators/land_wheel.h).
-    // A fit, with GnssSpec::latency_s, to Table 3's fusion errors; the plant's
-    // own default is an ideal wheel, which a case gets with deflection_pct: 0.
+    // Not the emulator's ideal wheel (0 %): a fit, with GnssSpec::latency_s, to
+    // Table 3's fusion errors; a case gets the ideal wheel with deflection_pct: 0.
     double deflection_pct = 3.0;
-    double terrain_sd_m_per_sqrt_m = 0.005;  // terrain random walk, [0, 1]
+    double terrain_sd_m_per_sqrt_m = kLandWheelDefaults.terrain_sd_m_per_sqrt_m;  // terrain random walk, [0, 1]
 };
 
 // The operator moves the throttle: from at_s the pump delivers flow_l_min.
@@ -209,22 +224,25 @@ struct HydraulicsSpec {
 };
 
 // Ranges of this and the sensors below: case_spec.cpp, with their reasons.
+inline const emulators::Kf11Params kKf11Defaults{};
 struct FlowMeterSpec {
-    double pulses_per_l = 90.0;              // KF11-P10, Eq. 3
-    double k_factor_error_pct = 0.0;
-    double rate_hz = 100.0;
+    double pulses_per_l = kKf11Defaults.pulses_per_l;  // k of Eq. 3
+    double k_factor_error_pct = kKf11Defaults.k_factor_error_pct;
+    double rate_hz = kKf11Defaults.rate_hz;
 };
 
+inline const emulators::PumpFlowSensorParams kPumpSensorDefaults{};
 struct PumpSensorSpec {
-    double full_scale_m3_h = 8.0;            // Q_F of Eq. 8: WL-LWGA-20 turbine, 0.8-8 m^3/h (sec. 2.2.2)
-    double noise_mv = 2.0;
-    double offset_ma = 0.0;
-    double rate_hz = 20.0;
+    double full_scale_m3_h = kPumpSensorDefaults.full_scale_m3_h;  // Q_F of Eq. 8
+    double noise_mv = kPumpSensorDefaults.noise_mv;
+    double offset_ma = kPumpSensorDefaults.offset_ma;
+    double rate_hz = kPumpSensorDefaults.rate_hz;
 };
 
+inline const emulators::BoomHeightSensorParams kBoomHeightSensorDefaults{};
 struct BoomHeightSensorSpec {
-    double range_m = 1.0;
-    double rate_hz = 10.0;
+    double range_m = kBoomHeightSensorDefaults.range_m;
+    double rate_hz = kBoomHeightSensorDefaults.rate_hz;
 };
 
 // How the ground's deposition is judged (harness/metrics.h).

@@ -13,6 +13,7 @@
 #include "harness/judge/judge_trace.h"
 #include "harness/systems/breakpoint/breakpoint_metrics.h"
 #include "harness/trace/trace_reader.h"
+#include "rig/papers/seed000.h"
 
 namespace rig::harness {
 
@@ -29,7 +30,7 @@ struct BreakpointJudgingPlan : JudgingPlan {
     bool judge_flow = false;
     FlowJudging flow;
     FlowWindow flow_window;
-    double kf11_pulses_per_l = 90.0;  // the meter's nameplate k (Eq. 3) for the paper-style readings
+    double kf11_pulses_per_l = papers::seed000::kFlowMeterPulsesPerLitre;  // the meter's nameplate k (Eq. 3)
     double kf11_window_s = 0.25;
     // Fig. 11 from truth (valve_calibration), over flow_window (the switch on).
     bool judge_fig11 = false;
