@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "rig/config/file_access.h"
+#include "rig/text/number_text.h"
 
 namespace rig::controller {
 
@@ -47,13 +48,8 @@ struct StoreContents {
     throw std::system_error(errno, std::generic_category(), "breakpoint store: " + what);
 }
 
-std::string format_double(double value) {
-    // Shortest text that reads back as exactly `value`, locale-independent.
-    std::array<char, 32> buffer{};
-    const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-    if (error != std::errc()) throw std::logic_error("breakpoint store: cannot format a double");
-    return std::string(buffer.data(), end);
-}
+// Shortest text that reads back as exactly `value`, locale-independent.
+std::string format_double(double value) { return shortest_text(value); }
 
 std::string format_crc(std::uint32_t crc) {
     std::array<char, kChecksumHexDigits> digits{};

@@ -1,4 +1,5 @@
 #include "emulators/spray_circuit.h"
+#include "rig/text/number_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -97,11 +98,7 @@ void SprayCircuit::advance_to(TimeNs t) {
 
 void SprayCircuit::require_advanced_to(TimeNs now_ns, const std::string& device) const {
     if (now_ns == advanced_to_ns_) return;
-    const auto seconds = [](TimeNs t) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.6f s", ns_to_seconds(t));
-        return std::string(text);
-    };
+    const auto seconds = [](TimeNs t) { return fixed_text(ns_to_seconds(t), 6) + " s"; };
     throw std::logic_error(device + " sampled the spray circuit at t=" + seconds(now_ns) +
                            " but the circuit was advanced to t=" + seconds(advanced_to_ns_) +
                            ": the master advances it to each instant before the devices step "

@@ -11,6 +11,7 @@
 #include "harness/judge/verdict.h"
 #include "harness/output/xml_text.h"
 #include "harness/report/build_info.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 
@@ -19,12 +20,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Four significant digits: the bands' spread, not the float's last bits.
-std::string number(double value) {
-    if (std::isnan(value)) return "-";
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g", value);
-    return text;
-}
+std::string number(double value) { return std::isnan(value) ? "-" : significant_text(value, 4); }
 
 std::string optional_number(const std::optional<double>& value) { return value ? number(*value) : "-"; }
 

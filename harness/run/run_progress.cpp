@@ -12,6 +12,7 @@
 
 #include "harness/judge/verdict.h"
 #include "harness/systems/systems.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 
@@ -34,11 +35,7 @@ std::string minutes_seconds(double seconds) {
     return text;
 }
 
-std::string one_decimal(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.1f", value);
-    return text;
-}
+std::string one_decimal(double value) { return fixed_text(value, 1); }
 
 double mean(const std::vector<double>& values) {
     return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());

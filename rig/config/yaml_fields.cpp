@@ -1,6 +1,7 @@
 #include "rig/config/yaml_fields.h"
 
 #include "rig/config/file_access.h"
+#include "rig/text/number_text.h"
 
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/parser.h>
@@ -83,11 +84,7 @@ std::string item_path(const std::string& parent, std::size_t index) {
 }
 
 // Shortest text that reads back as the same double ("0.16", not "0.160000").
-std::string number_text(double value) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-    return std::string(buffer, result.ptr);
-}
+std::string number_text(double value) { return shortest_text(value); }
 
 bool is_quoted(const YAML::Node& scalar) {
     // yaml-cpp tags plain scalars "?" and quoted ones "!".

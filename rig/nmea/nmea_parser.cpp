@@ -1,4 +1,5 @@
 #include "rig/nmea/nmea_parser.h"
+#include "rig/text/number_text.h"
 
 #include <algorithm>
 #include <array>
@@ -58,12 +59,7 @@ std::string quoted(std::string_view text) {
     return out;
 }
 
-std::string format_limit(double value) {
-    std::array<char, 32> buffer{};
-    const auto [end, ec] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-    if (ec != std::errc{}) return "?";
-    return std::string(buffer.data(), end);
-}
+std::string format_limit(double value) { return shortest_text(value); }
 
 ParseError make_error(ParseErrorCode code, std::string message) { return ParseError{code, std::move(message)}; }
 

@@ -1,4 +1,5 @@
 #include "rig/runtime/lateness.h"
+#include "rig/text/number_text.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,17 +8,10 @@ namespace rig {
 
 namespace {
 
-std::string fixed(double value, int decimals) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-    return buffer;
-}
+std::string fixed(double value, int decimals) { return fixed_text(value, decimals); }
 
-std::string shortest(double value) {
-    char buffer[64];
-    std::snprintf(buffer, sizeof buffer, "%g", value);
-    return buffer;
-}
+// printf's %g: six significant digits.
+std::string shortest(double value) { return significant_text(value, 6); }
 
 }  // namespace
 
