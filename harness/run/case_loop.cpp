@@ -219,7 +219,7 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, SystemNodes& nodes, Cas
     if (auto* modbus_wire = dynamic_cast<ModbusSlaveWire*>(session.wires().board_io.get())) {
         modbus_wire->set_wake([&dds] { dds.notify_data_arrived(); });
     }
-    BoardSilenceWatch board_silence(spec, session.wires());
+    BoardSilenceWatch board_silence(spec.board, session.wires());
     master.set_after_step([&](TimeNs t) {
         now_ns = t;
         trace.drain(t, 0);
@@ -247,7 +247,7 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, SystemNodes& nodes, Cas
     try {
         // A wired board: case time starts once it has attached (harness/board_attach.h).
         if (spec.wiring.external_controller) {
-            board = wait_for_board(spec, session.wires(), [&watchdog] { watchdog(); });
+            board = wait_for_board(spec.board, session.wires(), [&watchdog] { watchdog(); });
         }
         master.start();
         facts.startup_wall_seconds = wall.elapsed_s();

@@ -244,7 +244,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         if (spec.wiring.external_controller) {
             nlohmann::json described = nlohmann::json::object();
             world->describe_attach(described, session.domain_id());
-            announce_attach(spec, session.wires(), run_name, case_dir, std::cout, described);
+            announce_attach(spec.wiring, spec.board, session.wires(), run_name, case_dir, std::cout, described);
         }
         install_line_noise(spec.board, spec.wiring, seed, session.wires());  // board.line_noise, if any
 
@@ -263,7 +263,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
             world->end_ns(), now_ns);
         // Whatever the ending, what the system keeps of the run is part of the record.
         nodes->finish(trace.file(), facts, case_dir);
-        facts.board_io = board_io_report(spec, session.wires(), board);
+        facts.board_io = board_io_report(spec.board, session.wires(), board);
         if (options.dds_security_dir) {
             // Who tried to join and was refused (not in the digest: it depends on who was around).
             trace.file().set_meta("dds_security_refused", nlohmann::json(dds.refused_participants()).dump());

@@ -35,9 +35,8 @@ std::string line_settings(int baud) { return std::to_string(baud) + " 8N1"; }
 
 }  // namespace
 
-std::vector<AttachPort> attach_ports(const CaseSpec& spec, const BenchWires& wires) {
+std::vector<AttachPort> attach_ports(const WiringSpec& wiring, const BenchWires& wires) {
     std::vector<AttachPort> ports;
-    const WiringSpec& wiring = spec.wiring;
     if (wiring.gnss == GnssWire::serial) {
         ports.push_back(AttachPort{"gnss_nmea", wires.gnss_far_end, line_settings(wiring.nmea_baud),
                                    wires.gnss_pty ? kPtyOpened : kNotObservable});
@@ -84,14 +83,14 @@ nlohmann::json attach_json(const std::vector<AttachPort>& ports, const std::stri
             {"failsafe", std::string(modbus::to_string(board.failsafe))}};
 }
 
-void announce_attach(const CaseSpec& spec, const BenchWires& wires, const std::string& run_name,
+void announce_attach(const WiringSpec& wiring, const BoardSpec& board, const BenchWires& wires, const std::string& run_name,
                      const std::filesystem::path& case_dir, std::ostream& out, const nlohmann::json& system) {
-    const std::vector<AttachPort> ports = attach_ports(spec, wires);
+    const std::vector<AttachPort> ports = attach_ports(wiring, wires);
     // The file first: whoever reacts to the line finds the file already there.
-    nlohmann::json attach = attach_json(ports, run_name, spec.board);
+    nlohmann::json attach = attach_json(ports, run_name, board);
     if (system.is_object()) attach.update(system);
     write_file_atomically(case_dir / "attach.json", attach.dump(2) + "\n");
-    out << attach_line(ports, run_name, spec.board) << std::endl;
+    out << attach_line(ports, run_name, board) << std::endl;
 }
 
 std::vector<int> processes_holding(const std::filesystem::path& path) {
@@ -122,7 +121,7 @@ modbus::ModbusSlave* modbus_slave_of(BenchWires& wires) {
     return wire ? &wire->slave() : nullptr;
 }
 
-BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const std::function<void()>& watchdog) {
+BoardAttachment wait_for_board(const BoardSpec& board, BenchWires& wires, const std::function<void()>& watchdog) {
     const WallStopwatch waited;
     BoardAttachment attachment;
     modbus::ModbusSlave* slave = modbus_slave_of(wires);
@@ -146,7 +145,7 @@ BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const st
                                       seconds_text(waited.elapsed_s()) + " s");
         }
         if (nmea_open && laser_open && modbus_heard) break;
-        if (waited.elapsed_s() > spec.board.attach_timeout_s) {
+        if (waited.elapsed_s() > board.attach_timeout_s) {
             std::string missing;
             if (!nmea_open) missing += "no process opened the GNSS NMEA line " + wires.gnss_far_end;
             if (!laser_open) {
@@ -160,7 +159,7 @@ BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const st
                            std::to_string(stats.malformed_frames) + " malformed)";
             }
             throw NodeFailure(FailureKind::board_not_attached, "board",
-                              "not attached within board.attach_timeout_s = " + seconds_text(spec.board.attach_timeout_s, 1) +
+                              "not attached within board.attach_timeout_s = " + seconds_text(board.attach_timeout_s, 1) +
                                   " s: " + missing);
         }
         watchdog();
@@ -170,9 +169,9 @@ BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const st
     return attachment;
 }
 
-BoardSilenceWatch::BoardSilenceWatch(const CaseSpec& spec, BenchWires& wires)
+BoardSilenceWatch::BoardSilenceWatch(const BoardSpec& board, BenchWires& wires)
     : slave_(modbus_slave_of(wires)),
-      timeout_(std::chrono::nanoseconds(seconds_to_ns(spec.board.silence_timeout_s))) {}
+      timeout_(std::chrono::nanoseconds(seconds_to_ns(board.silence_timeout_s))) {}
 
 void BoardSilenceWatch::check(TimeNs case_now_ns) {
     if (slave_ == nullptr) return;
@@ -196,7 +195,7 @@ void BoardSilenceWatch::check(TimeNs case_now_ns) {
     throw NodeFailure(FailureKind::board_silent, "board", message);
 }
 
-nlohmann::json board_io_report(const CaseSpec& spec, BenchWires& wires, const std::optional<BoardAttachment>& attachment) {
+nlohmann::json board_io_report(const BoardSpec& board, BenchWires& wires, const std::optional<BoardAttachment>& attachment) {
     modbus::ModbusSlave* slave = modbus_slave_of(wires);
     if (slave == nullptr) return nullptr;
     const modbus::ModbusSlaveStatistics stats = slave->statistics();
@@ -218,10 +217,10 @@ nlohmann::json board_io_report(const CaseSpec& spec, BenchWires& wires, const st
           {"malformed", stats.malformed_frames},  // RTU truncated or oversized; TCP bad MBAP header
           {"response_not_sent", stats.responses_not_sent}}},
         {"failsafe",
-         {{"mode", std::string(modbus::to_string(spec.board.failsafe))},
-          {"timeout_s", spec.board.failsafe_timeout_s},
+         {{"mode", std::string(modbus::to_string(board.failsafe))},
+          {"timeout_s", board.failsafe_timeout_s},
           {"trips", stats.failsafe_trips}}},
-        {"silence_timeout_s", spec.board.silence_timeout_s},
+        {"silence_timeout_s", board.silence_timeout_s},
         {"last_problem", stats.last_problem},
     };
     if (wires.line_noise) report["line_noise"] = line_noise_json(*wires.line_noise);

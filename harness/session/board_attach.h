@@ -42,7 +42,7 @@ struct AttachPort {
     std::string settings;  // "115200 8N1", "slave 1 115200 8N1"
     std::string attached_when;  // what the rig waits for on it, or "not observable"
 };
-std::vector<AttachPort> attach_ports(const CaseSpec& spec, const BenchWires& wires);
+std::vector<AttachPort> attach_ports(const WiringSpec& wiring, const BenchWires& wires);
 // "attach: gnss_nmea=/dev/pts/5 modbus_rtu=/dev/pts/7 (case NAME; waiting up to 60 s)"
 std::string attach_line(const std::vector<AttachPort>& ports, const std::string& run_name, const BoardSpec& board);
 nlohmann::json attach_json(const std::vector<AttachPort>& ports, const std::string& run_name, const BoardSpec& board);
@@ -50,7 +50,7 @@ nlohmann::json attach_json(const std::vector<AttachPort>& ports, const std::stri
 // Prints attach_line() on `out` (flushed) and writes attach.json into case_dir,
 // with `system`'s keys besides the ports (what the case's system tells a
 // board: seed 000's register scalings, seed 001's DDS domain and job file).
-void announce_attach(const CaseSpec& spec, const BenchWires& wires, const std::string& run_name,
+void announce_attach(const WiringSpec& wiring, const BoardSpec& board, const BenchWires& wires, const std::string& run_name,
                      const std::filesystem::path& case_dir, std::ostream& out, const nlohmann::json& system);
 
 // Other processes holding `path` open, found in /proc/*/fd (this process left
@@ -64,7 +64,7 @@ struct BoardAttachment {
 // Blocks until every observable wire end is attached; calls `watchdog` between
 // looks (it may throw, e.g. on SIGINT). Throws NodeFailure(board_not_attached)
 // naming each port still waited for after board.attach_timeout_s.
-BoardAttachment wait_for_board(const CaseSpec& spec, BenchWires& wires, const std::function<void()>& watchdog);
+BoardAttachment wait_for_board(const BoardSpec& board, BenchWires& wires, const std::function<void()>& watchdog);
 
 // The rig's Modbus slave on this case's wires, if it has one.
 modbus::ModbusSlave* modbus_slave_of(BenchWires& wires);
@@ -74,7 +74,7 @@ modbus::ModbusSlave* modbus_slave_of(BenchWires& wires);
 // start until its first request). Does nothing on cases without a Modbus wire.
 class BoardSilenceWatch {
 public:
-    BoardSilenceWatch(const CaseSpec& spec, BenchWires& wires);
+    BoardSilenceWatch(const BoardSpec& board, BenchWires& wires);
     // `case_now_ns`: the case clock, for the message.
     void check(TimeNs case_now_ns);
 
@@ -85,6 +85,6 @@ private:
 };
 
 // The slave's frame counts per kind, the fail-safe and the attachment: results.json `realtime.board_io`.
-nlohmann::json board_io_report(const CaseSpec& spec, BenchWires& wires, const std::optional<BoardAttachment>& attachment);
+nlohmann::json board_io_report(const BoardSpec& board, BenchWires& wires, const std::optional<BoardAttachment>& attachment);
 
 }  // namespace rig::harness
