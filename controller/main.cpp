@@ -19,14 +19,13 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <memory>
 
 #include "controller/controller_config.h"
 #include "controller/reference_controller.h"
 #include "controller/wired_board_controller.h"
-#include "rig/runtime/dds_context.h"
-#include "rig/runtime/lockstep.h"
+#include "rig/runtime/follower.h"
 #include "rig/wire/modbus_protocol.h"
-#include "rig/runtime/realtime.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Reference breakpoint-spraying controller (seed 000) as a rig node"};
@@ -62,43 +61,39 @@ int main(int argc, char** argv) {
     const bool wired_mode = !wired.nmea_port.empty() || !modbus_rtu_device.empty() || !modbus_tcp.empty();
     try {
         const auto config = rig::controller::load_controller_config(config_file);
-        rig::FollowerOptions options;
-        options.node_name = node_name;
-        if (stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(stall_at_s);
+        rig::FollowerStartup startup;
+        startup.domain_id = domain_id;
+        startup.clock = rig::clock_mode_from(clock_mode);
+        startup.options.node_name = node_name;
+        if (stall_at_s >= 0.0) startup.options.stall_at_ns = rig::seconds_to_ns(stall_at_s);
         // TEST-ONLY fault (the catalogue of faulty controllers): the same stall from the case file.
-        if (config.faults.stall_at_s >= 0.0) options.stall_at_ns = rig::seconds_to_ns(config.faults.stall_at_s);
-        rig::DdsContext dds(domain_id, node_name, /*watch_discovery=*/false,
-                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
-                                                     : rig::ReliabilityTimers::few_wakeups);
-        if (wired_mode) {
-            if (clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
-            if (modbus_rtu_device.empty() == modbus_tcp.empty()) {
-                throw std::runtime_error("wired mode needs exactly one of --modbus-rtu and --modbus-tcp");
+        if (config.faults.stall_at_s >= 0.0) startup.options.stall_at_ns = rig::seconds_to_ns(config.faults.stall_at_s);
+        // The node is made once the follower's DDS context exists
+        // (rig/runtime/follower.h); the wired options are checked as it is made.
+        return rig::run_follower(startup, [&]() -> std::unique_ptr<rig::Node> {
+            if (wired_mode) {
+                if (startup.clock != rig::ClockMode::realtime) {
+                    throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
+                }
+                if (modbus_rtu_device.empty() == modbus_tcp.empty()) {
+                    throw std::runtime_error("wired mode needs exactly one of --modbus-rtu and --modbus-tcp");
+                }
+                if (!modbus_rtu_device.empty()) {
+                    rig::modbus::RtuMasterOptions rtu;
+                    rtu.line.device = modbus_rtu_device;
+                    rtu.line.baud = modbus_baud;
+                    rtu.line.parity = rig::modbus::parse_parity(modbus_parity);
+                    rtu.slave_id = static_cast<std::uint8_t>(modbus_slave_id);
+                    wired.modbus_rtu = rtu;
+                } else {
+                    rig::modbus::TcpMasterOptions tcp;
+                    tcp.slave = rig::modbus::parse_tcp_endpoint(modbus_tcp);
+                    wired.modbus_tcp = tcp;
+                }
+                return std::make_unique<rig::controller::WiredBoardController>(node_name, config, state_dir, wired);
             }
-            if (!modbus_rtu_device.empty()) {
-                rig::modbus::RtuMasterOptions rtu;
-                rtu.line.device = modbus_rtu_device;
-                rtu.line.baud = modbus_baud;
-                rtu.line.parity = rig::modbus::parse_parity(modbus_parity);
-                rtu.slave_id = static_cast<std::uint8_t>(modbus_slave_id);
-                wired.modbus_rtu = rtu;
-            } else {
-                rig::modbus::TcpMasterOptions tcp;
-                tcp.slave = rig::modbus::parse_tcp_endpoint(modbus_tcp);
-                wired.modbus_tcp = tcp;
-            }
-            rig::controller::WiredBoardController controller(node_name, config, state_dir, wired);
-            std::cerr << node_name << ": "
-                      << rig::request_realtime_scheduling(40).detail << "\n";
-            return rig::run_realtime_follower(controller, dds, options);
-        }
-        rig::controller::ReferenceController controller(node_name, config, state_dir);
-        if (clock_mode == "realtime") {
-            std::cerr << node_name << ": " << rig::request_realtime_scheduling(40).detail << "\n";
-            return rig::run_realtime_follower(controller, dds, options);
-        }
-        rig::ManualClock clock;
-        return rig::run_lockstep_follower(controller, dds, clock, options);
+            return std::make_unique<rig::controller::ReferenceController>(node_name, config, state_dir);
+        });
     } catch (const std::exception& error) {
         std::cerr << node_name << ": " << error.what() << "\n";
         return 2;

@@ -5,18 +5,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "emulators/param_check.h"
+
 namespace rig::emulators {
-namespace {
-
-void check_range(const char* name, double value, double lo, double hi, bool hi_open = false) {
-    const bool ok = std::isfinite(value) && value >= lo && (hi_open ? value < hi : value <= hi);
-    if (!ok) {
-        throw std::invalid_argument(std::string("ad300.") + name + ": must be in [" + std::to_string(lo) + ", " +
-                                    std::to_string(hi) + (hi_open ? ")" : "]") + ", got " + std::to_string(value));
-    }
-}
-
-}  // namespace
 
 Ad300Receiver::Ad300Receiver(const field2d::SprayerKinematics& kinematics, Ad300Params params)
     : kinematics_(kinematics), params_(std::move(params)), noise_(params_.seed, "ad300.noise") {
@@ -28,18 +19,18 @@ Ad300Receiver::Ad300Receiver(const field2d::SprayerKinematics& kinematics, Ad300
         throw std::invalid_argument("ad300.rate_hz: must be in (0, 100], got " + std::to_string(params_.rate_hz));
     }
     const double period_s = 1.0 / params_.rate_hz;
-    check_range("latency_s", params_.latency_s, 0.0, 1.0);
-    check_range("noise_base_m", params_.noise_base_m, 0.0, 100.0);
-    check_range("noise_ppm", params_.noise_ppm, 0.0, 1000.0);
-    check_range("baseline_km", params_.baseline_km, 0.0, 1000.0);
-    check_range("velocity_noise_m_s", params_.velocity_noise_m_s, 0.0, 10.0);
-    check_range("min_course_speed_m_s", params_.min_course_speed_m_s, 0.0, 10.0);
-    check_range("utc_start_seconds_of_day", params_.utc_start_seconds_of_day, 0.0, 86400.0, true);
+    check_range("ad300", "latency_s", params_.latency_s, 0.0, 1.0);
+    check_range("ad300", "noise_base_m", params_.noise_base_m, 0.0, 100.0);
+    check_range("ad300", "noise_ppm", params_.noise_ppm, 0.0, 1000.0);
+    check_range("ad300", "baseline_km", params_.baseline_km, 0.0, 1000.0);
+    check_range("ad300", "velocity_noise_m_s", params_.velocity_noise_m_s, 0.0, 10.0);
+    check_range("ad300", "min_course_speed_m_s", params_.min_course_speed_m_s, 0.0, 10.0);
+    check_range("ad300", "utc_start_seconds_of_day", params_.utc_start_seconds_of_day, 0.0, 86400.0, true);
     if (params_.utc_month < 1 || params_.utc_month > 12 || params_.utc_day < 1 || params_.utc_day > 28) {
         throw std::invalid_argument("ad300.utc_month/utc_day: month 1-12 and day 1-28 (runs do not cross a month)");
     }
     if (params_.epoch_phase_s) {
-        check_range("epoch_phase_s", *params_.epoch_phase_s, 0.0, period_s, true);
+        check_range("ad300", "epoch_phase_s", *params_.epoch_phase_s, 0.0, period_s, true);
         phase_s_ = *params_.epoch_phase_s;
     } else {
         SeededRandom phase_draw(params_.seed, "ad300.epoch_phase");

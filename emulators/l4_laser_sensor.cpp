@@ -3,18 +3,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "emulators/param_check.h"
+
 namespace rig::emulators {
-namespace {
-
-void check_range(const char* name, double value, double lo, double hi, bool hi_open = false) {
-    const bool ok = std::isfinite(value) && value >= lo && (hi_open ? value < hi : value <= hi);
-    if (!ok) {
-        throw std::invalid_argument(std::string("l4_laser.") + name + ": must be in [" + std::to_string(lo) + ", " +
-                                    std::to_string(hi) + (hi_open ? ")" : "]") + ", got " + std::to_string(value));
-    }
-}
-
-}  // namespace
 
 std::string format_l4_distance(double distance_m, int decimals) {
     if (!std::isfinite(distance_m) || distance_m < 0.0 || distance_m > 1e6) {
@@ -37,15 +28,15 @@ L4LaserSensor::L4LaserSensor(const field2d::SprayerKinematics& kinematics, L4Las
         throw std::invalid_argument("l4_laser.rate_hz: must be in (0, 20], got " + std::to_string(params_.rate_hz));
     }
     const double period_s = 1.0 / params_.rate_hz;
-    check_range("latency_s", params_.latency_s, 0.0, 1.0);
-    check_range("mount_offset_m", params_.mount_offset_m, -1.0, 2.0);
-    check_range("accuracy_base_m", params_.accuracy_base_m, 0.0, 1.0);
-    check_range("accuracy_per_m", params_.accuracy_per_m, 0.0, 0.1);
+    check_range("l4_laser", "latency_s", params_.latency_s, 0.0, 1.0);
+    check_range("l4_laser", "mount_offset_m", params_.mount_offset_m, -1.0, 2.0);
+    check_range("l4_laser", "accuracy_base_m", params_.accuracy_base_m, 0.0, 1.0);
+    check_range("l4_laser", "accuracy_per_m", params_.accuracy_per_m, 0.0, 0.1);
     if (!(params_.resolution_m > 0.0) || params_.resolution_m > 0.1) {
         throw std::invalid_argument("l4_laser.resolution_m: must be in (0, 0.1], got " +
                                     std::to_string(params_.resolution_m));
     }
-    check_range("min_range_m", params_.min_range_m, 0.0, 1000.0);
+    check_range("l4_laser", "min_range_m", params_.min_range_m, 0.0, 1000.0);
     if (!std::isfinite(params_.max_range_m) || params_.max_range_m <= params_.min_range_m) {
         throw std::invalid_argument("l4_laser.max_range_m: must be finite and > min_range_m");
     }
@@ -53,7 +44,7 @@ L4LaserSensor::L4LaserSensor(const field2d::SprayerKinematics& kinematics, L4Las
         throw std::invalid_argument("l4_laser.decimals: must be 3 or 4, got " + std::to_string(params_.decimals));
     }
     if (params_.phase_s) {
-        check_range("phase_s", *params_.phase_s, 0.0, period_s, true);
+        check_range("l4_laser", "phase_s", *params_.phase_s, 0.0, period_s, true);
         phase_s_ = *params_.phase_s;
     } else {
         SeededRandom phase_draw(params_.seed, "l4_laser.phase");

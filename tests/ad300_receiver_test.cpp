@@ -207,4 +207,19 @@ TEST(Ad300Receiver, BadParametersAreRejectedByName) {
     expect_bad(p, "latency_s");
 }
 
+// The whole text, as the case's load error shows it (emulators/param_check.h):
+// the key, the bounds (an open upper one too) and the value, six decimals each.
+TEST(Ad300Receiver, ARangeErrorSaysTheKeyTheBoundsAndTheValue) {
+    const SprayerKinematics k = north_at(1.0, 10.0);
+    Ad300Params p;
+    p.utc_start_seconds_of_day = 86400.0;
+    try {
+        Ad300Receiver rx(k, p);
+        ADD_FAILURE() << "86400 s of day was taken";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "ad300.utc_start_seconds_of_day: must be in [0.000000, 86400.000000), got 86400.000000");
+    }
+}
+
 }  // namespace

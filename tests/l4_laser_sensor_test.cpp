@@ -117,6 +117,19 @@ TEST(L4Laser, BadParametersAreRejectedByName) {
     EXPECT_THROW(L4LaserSensor(k, p), std::invalid_argument);
 }
 
+// The whole text, as the case's load error shows it (emulators/param_check.h).
+TEST(L4Laser, ARangeErrorSaysTheKeyTheBoundsAndTheValue) {
+    const SprayerKinematics k = standing(BoomHeightProfile{});
+    L4LaserParams p;
+    p.mount_offset_m = -1.25;
+    try {
+        L4LaserSensor laser(k, p);
+        ADD_FAILURE() << "a mount offset of -1.25 m was taken";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "l4_laser.mount_offset_m: must be in [-1.000000, 2.000000], got -1.250000");
+    }
+}
+
 TEST(L4LaserParser, HostileLinesGiveErrorsNotCrashes) {
     EXPECT_DOUBLE_EQ(*parse_l4_line("D=0.503m\r\n").distance_m, 0.503);
     EXPECT_DOUBLE_EQ(*parse_l4_line("D=0.503m").distance_m, 0.503);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -10,6 +12,7 @@
 #include "rig/host/child_process.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/host/domain_lease.h"
+#include "rig/runtime/follower.h"
 #include "rig/runtime/lockstep.h"
 #include "idl/topics.h"
 
@@ -213,6 +216,63 @@ TEST(Lockstep, TheHelloIsSentAgainUntilEveryNodeAnswered) {
     late_reader.join();
     EXPECT_GE(hellos_seen, 2);
     master.shutdown(true);  // the node is gone: do not wait for its last answer
+}
+
+// A node that only reads, and says when it was configured and destroyed.
+class LonelyReader final : public rig::Node {
+public:
+    LonelyReader(bool& configured, bool& destroyed) : configured_(configured), destroyed_(destroyed) {}
+    ~LonelyReader() override { destroyed_ = true; }
+    const std::string& name() const override { return name_; }
+    void configure(rig::DdsContext& dds) override {
+        reader_ = std::make_unique<rig::Reader<rig::msg::NmeaSentence>>(dds, "test/lonely");
+        configured_ = true;
+    }
+    rig::TimeNs step(rig::TimeNs) override { return rig::kNever; }
+
+private:
+    std::string name_ = "lonely";
+    bool& configured_;
+    bool& destroyed_;
+    std::unique_ptr<rig::Reader<rig::msg::NmeaSentence>> reader_;
+};
+
+rig::FollowerStartup lonely_startup(const rig::DomainLease& lease) {
+    rig::FollowerStartup startup;
+    startup.domain_id = lease.domain_id();
+    startup.options.node_name = "lonely";
+    startup.options.startup_timeout = std::chrono::milliseconds(300);
+    return startup;
+}
+
+// run_follower (rig/runtime/follower.h) with no rig on the domain: the node it
+// made is configured on the follower's context, the start-up gives up after
+// its bound with status 3 (no counterpart) naming what was unmatched, and the
+// node is gone when the call returns.
+TEST(Follower, WithoutARigTheStartUpGivesUpWithStatus3) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    bool configured = false;
+    bool destroyed = false;
+    ::testing::internal::CaptureStderr();
+    const int status =
+        rig::run_follower(lonely_startup(lease), [&] { return std::make_unique<LonelyReader>(configured, destroyed); });
+    const std::string said = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(status, 3);
+    EXPECT_TRUE(configured);
+    EXPECT_TRUE(destroyed);
+    EXPECT_NE(said.find("lonely: no DDS counterpart within 300 ms for: "), std::string::npos) << said;
+    EXPECT_NE(said.find("reads test/lonely"), std::string::npos) << said;
+}
+
+// What the factory throws (a bad configuration) reaches the program's own
+// handler, which says it with the node's name; a factory that makes nothing is
+// a programming error.
+TEST(Follower, WhatTheFactoryThrowsComesOutOfRunFollower) {
+    const rig::DomainLease lease = rig::DomainLease::acquire();
+    EXPECT_THROW(rig::run_follower(lonely_startup(lease),
+                                   []() -> std::unique_ptr<rig::Node> { throw std::runtime_error("bad config"); }),
+                 std::runtime_error);
+    EXPECT_THROW(rig::run_follower(lonely_startup(lease), [] { return std::unique_ptr<rig::Node>(); }), std::logic_error);
 }
 
 }  // namespace

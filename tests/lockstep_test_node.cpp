@@ -4,10 +4,11 @@
 // prove the master fails such a node by name in bounded wall time.
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 
 #include "rig/runtime/dds_context.h"
-#include "rig/runtime/lockstep.h"
+#include "rig/runtime/follower.h"
 
 namespace {
 
@@ -58,11 +59,11 @@ int main(int argc, char** argv) {
         else if (key == "--period-ms") period_ns = std::stoll(value) * 1'000'000;
         else if (key == "--stall-at-ms") stall_at_ns = std::stoll(value) * 1'000'000;
     }
-    rig::DdsContext dds(domain, name);
-    rig::ManualClock clock;
-    EchoNode node(name, period_ns, stall_at_ns);
-    rig::FollowerOptions options;
-    options.node_name = name;
-    options.idle_timeout = std::chrono::milliseconds(20'000);
-    return rig::run_lockstep_follower(node, dds, clock, options);
+    // The start-up a controller process makes (rig/runtime/follower.h), so the
+    // lockstep tests run it too.
+    rig::FollowerStartup startup;
+    startup.domain_id = domain;
+    startup.options.node_name = name;
+    startup.options.idle_timeout = std::chrono::milliseconds(20'000);
+    return rig::run_follower(startup, [&] { return std::make_unique<EchoNode>(name, period_ns, stall_at_ns); });
 }

@@ -38,6 +38,7 @@ TEST(Sdk, TheExampleControllerBuildsAgainstAnInstalledRigAndIsJudgedInACase) {
     for (const char* file : {"lib/cmake/rig/rigConfig.cmake", "lib/cmake/rig/rigConfigVersion.cmake",
                              "lib/cmake/rig/rigTargets.cmake", "lib/librig_node.a", "lib/librig_idl.a",
                              "lib/librig_nmea.a", "include/rig/runtime/dds_context.h", "include/rig/runtime/lockstep.h",
+                             "include/rig/runtime/follower.h",
                              "include/rig/nmea/nmea_parser.h", "include/rig/idl/topics.h",
                              "include/rig/idl/controllerPubSubTypes.h", "share/rig/idl/topics.json",
                              "share/rig/idl/clock.idl", "share/rig/docs/controller-contract.md", "bin/rig",

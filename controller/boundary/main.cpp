@@ -16,12 +16,11 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <memory>
 
 #include "controller/boundary/boundary_controller_node.h"
 #include "controller/boundary/boundary_node_config.h"
-#include "rig/runtime/dds_context.h"
-#include "rig/runtime/lockstep.h"
-#include "rig/runtime/realtime.h"
+#include "rig/runtime/follower.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"Reference boundary shut-off controller (seed 001) as a rig node"};
@@ -68,24 +67,17 @@ int main(int argc, char** argv) {
     try {
         const bool wired = !serial.nmea_port.empty() || !serial.laser_port.empty();
         if (wired && clock_mode != "realtime") throw std::runtime_error("wired mode runs on the wall clock: add --clock realtime");
-        // The context first: the node's readers and writers unregister from it
-        // when the node is destroyed, so it must outlive the node.
-        rig::DdsContext dds(domain_id, node_name, /*watch_discovery=*/false,
-                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
-                                                     : rig::ReliabilityTimers::few_wakeups);
-        rig::controller::boundary::BoundaryControllerNode controller(
-            node_name,
-            rig::controller::boundary::load_boundary_node_config(
-                config_file, job_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(job_file)),
-            serial);
-        rig::FollowerOptions options;
-        options.node_name = node_name;
-        if (clock_mode == "realtime") {
-            std::cerr << node_name << ": " << rig::request_realtime_scheduling(40).detail << "\n";
-            return rig::run_realtime_follower(controller, dds, options);
-        }
-        rig::ManualClock clock;
-        return rig::run_lockstep_follower(controller, dds, clock, options);
+        rig::FollowerStartup startup;
+        startup.domain_id = domain_id;
+        startup.clock = rig::clock_mode_from(clock_mode);
+        startup.options.node_name = node_name;
+        return rig::run_follower(startup, [&] {
+            return std::make_unique<rig::controller::boundary::BoundaryControllerNode>(
+                node_name,
+                rig::controller::boundary::load_boundary_node_config(
+                    config_file, job_file.empty() ? std::nullopt : std::optional<std::filesystem::path>(job_file)),
+                serial);
+        });
     } catch (const std::exception& error) {
         std::cerr << node_name << ": " << error.what() << "\n";
         return 2;

@@ -23,9 +23,8 @@
 #include "idl/topics.h"
 #include "rig/nmea/nmea_parser.h"
 #include "rig/runtime/dds_context.h"
-#include "rig/runtime/lockstep.h"
+#include "rig/runtime/follower.h"
 #include "rig/runtime/node.h"
-#include "rig/runtime/realtime.h"
 
 namespace {
 
@@ -166,17 +165,19 @@ int main(int argc, char** argv) {
         // --state-dir: this controller keeps no state between runs.
     }
     try {
-        // The context before the node: the node's readers and writers leave the
-        // context when the node is destroyed, so the context must outlive it.
-        rig::DdsContext dds(domain, node_name, /*watch_discovery=*/false,
-                            clock_mode == "realtime" ? rig::ReliabilityTimers::prompt_repair
-                                                     : rig::ReliabilityTimers::few_wakeups);
-        RtkBreakpointController controller(node_name, setting(config, "antenna_to_nozzle_m").value_or(1.63));
-        rig::FollowerOptions options;
-        options.node_name = node_name;
-        if (clock_mode == "realtime") return rig::run_realtime_follower(controller, dds, options);
-        rig::ManualClock clock;
-        return rig::run_lockstep_follower(controller, dds, clock, options);
+        rig::FollowerStartup startup;
+        startup.domain_id = domain;
+        startup.clock = rig::clock_mode_from(clock_mode);
+        startup.options.node_name = node_name;
+        // On the wall clock this example stays at the scheduler's default.
+        // Without this line run_follower asks for SCHED_FIFO 40 and locked
+        // memory, as the rig's reference controllers do.
+        startup.realtime_priority = std::nullopt;
+        // The node is made once the DDS context exists, and destroyed before it.
+        return rig::run_follower(startup, [&] {
+            return std::make_unique<RtkBreakpointController>(node_name,
+                                                             setting(config, "antenna_to_nozzle_m").value_or(1.63));
+        });
     } catch (const std::exception& error) {
         std::cerr << node_name << ": " << error.what() << "\n";
         return 2;
