@@ -145,7 +145,7 @@ TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
 // wired case reads as written; each wire that cannot work is refused at its key.
 TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {
     const CaseSpec wired = parse_case(shipped("bench-wired/seed001-drive-out-wired.yaml"), "drive-out-wired.yaml");
-    EXPECT_EQ(wired.mode, RunMode::realtime);
+    EXPECT_EQ(wired.mode, rig::ClockMode::realtime);
     EXPECT_EQ(wired.wiring.gnss, GnssWire::serial);
     EXPECT_EQ(wired.wiring.laser, GnssWire::serial);
     EXPECT_EQ(wired.wiring.laser_port, "pty");

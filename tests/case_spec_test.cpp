@@ -144,7 +144,7 @@ TEST(CaseSpec, FullFileParsesToTheWrittenValues) {
     EXPECT_EQ(spec.name, "breakpoint-6kmh-fusion-s1");
     EXPECT_EQ(spec.description, "free text");
     EXPECT_EQ(spec.seed, 7u);
-    EXPECT_EQ(spec.mode, RunMode::realtime);
+    EXPECT_EQ(spec.mode, ClockMode::realtime);
     EXPECT_EQ(breakpoint_sections(spec).utc_start_iso, "2023-07-15T02:00:00.25Z");
     EXPECT_EQ(breakpoint_sections(spec).utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h + 250ms);
 
@@ -216,7 +216,7 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     EXPECT_EQ(spec.name, "minimal");
     EXPECT_EQ(spec.description, "");
     EXPECT_EQ(spec.seed, 1u);
-    EXPECT_EQ(spec.mode, RunMode::lockstep);
+    EXPECT_EQ(spec.mode, ClockMode::lockstep);
     EXPECT_EQ(breakpoint_sections(spec).utc_start, std::chrono::sys_days{std::chrono::year{2023} / 7 / 15} + 2h);
     EXPECT_DOUBLE_EQ(breakpoint_sections(spec).field.origin.height_m, 0.0);
     EXPECT_DOUBLE_EQ(breakpoint_sections(spec).vehicle.accel_m_s2, 0.5);

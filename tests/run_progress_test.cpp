@@ -58,7 +58,7 @@ TEST(EstimateSecondsLeft, LockstepCasesShareTheJobsAndRealTimeCasesLastTheirLeng
 
 CaseSpec lockstep_spec() {
     CaseSpec spec;
-    spec.mode = RunMode::lockstep;
+    spec.mode = ClockMode::lockstep;
     spec.source_path = "cases/suite/a.yaml";
     return spec;
 }

@@ -262,7 +262,7 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
     for (const CaseSpec& spec : specs) {
-        if (spec.mode == RunMode::realtime) {
+        if (spec.mode == ClockMode::realtime) {
             std::cerr << "rig sweep: " << spec.source_path.string()
                       << ": a real-time case runs on the wall clock, so " << sweep.seeds
                       << " seeds would take that many times its length; sweep lockstep cases (rig run takes --seed)\n";

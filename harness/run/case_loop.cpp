@@ -277,7 +277,7 @@ void run_loop(const CaseSpec& spec, DdsContext& dds, SystemNodes& nodes, CaseSes
               const WallStopwatch& wall, TimeNs end_ns, TimeNs& now_ns, RunFacts& facts,
               std::optional<BoardAttachment>& board, CaseClock* clock) {
     Watchdog watchdog(spec.timeouts, wall, dds, trace, session, now_ns, clock);
-    if (spec.mode == RunMode::lockstep) {
+    if (spec.mode == ClockMode::lockstep) {
         run_lockstep(spec.timeouts, dds, nodes, session, trace, watchdog, end_ns, now_ns, facts, wall);
     } else {
         run_realtime(spec, dds, nodes, session, trace, watchdog, end_ns, now_ns, facts, board, wall);

@@ -22,6 +22,7 @@
 #include "harness/trace/trace_recorder.h"
 #include "rig/host/child_process.h"
 #include "rig/host/cpu_lease.h"
+#include "rig/runtime/follower.h"
 
 namespace rig::harness {
 
@@ -133,7 +134,7 @@ ControllerPlacement place_controller(const CaseSpec& spec, const RunOptions& opt
     if (!wanted || spec.wiring.external_controller) return placement;
     // The case file's own `in_process: true` was checked when it was read; these
     // are cases `--in-process` asks of that cannot comply.
-    if (spec.mode != RunMode::lockstep) {
+    if (spec.mode != ClockMode::lockstep) {
         placement.refused = "a real-time case: its controller runs as a process on the wall clock";
         return placement;
     }
@@ -201,7 +202,7 @@ CaseRun run_case(const CaseSpec& spec, const RunOptions& options) {
 CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& run_name, const RunOptions& options) {
     // A lockstep case's chain of hand-offs (this thread, Fast DDS's threads, the
     // controller process) on one CPU; a real-time case keeps the scheduler's.
-    const CpuLease cpu(options.pin_cpu && spec.mode == RunMode::lockstep);
+    const CpuLease cpu(options.pin_cpu && spec.mode == ClockMode::lockstep);
     const WallStopwatch wall;
     const std::filesystem::path case_dir = options.out_dir / "cases" / run_name;
     const std::filesystem::path trace_file = case_dir / "trace.sqlite";
@@ -325,7 +326,7 @@ std::vector<CaseRun> run_cases(const std::vector<CaseSpec>& specs, const RunOpti
     // so that other cases' load does not become its scheduling jitter.
     std::vector<std::size_t> lockstep, realtime;
     for (std::size_t i = 0; i < instances.size(); ++i) {
-        (specs[instances[i].spec_index].mode == RunMode::realtime ? realtime : lockstep).push_back(i);
+        (specs[instances[i].spec_index].mode == ClockMode::realtime ? realtime : lockstep).push_back(i);
     }
     std::atomic<std::size_t> next{0};
     auto worker = [&] {

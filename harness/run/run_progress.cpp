@@ -146,7 +146,7 @@ void TerminalProgress::runs_planned(const std::vector<CaseInstance>& runs, const
             const CaseSpec& spec = specs[instance.spec_index];
             Run run;
             run.name = instance.name;
-            run.realtime = spec.mode == RunMode::realtime;
+            run.realtime = spec.mode == ClockMode::realtime;
             // A real-time case lasts its route on the wall clock: known before it runs.
             if (run.realtime) {
                 try {

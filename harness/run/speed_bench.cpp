@@ -161,7 +161,7 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
         try {
             CaseSpec spec = load_case_file(file);
             validate_for_run(spec, options.run);
-            if (spec.mode != RunMode::lockstep) {
+            if (spec.mode != ClockMode::lockstep) {
                 err << "rig bench: " << file << ": a real-time case runs at 1x by definition; give lockstep cases\n";
                 return 2;
             }

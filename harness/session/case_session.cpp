@@ -170,7 +170,7 @@ void CaseSession::start_controller(const CaseSpec& spec, const std::filesystem::
         argv.push_back(arg);
     }
     argv.insert(argv.end(), inputs.begin(), inputs.end());
-    if (spec.mode == RunMode::realtime) {
+    if (spec.mode == ClockMode::realtime) {
         argv.insert(argv.end(), {"--clock", "realtime"});
         argv.insert(argv.end(), wires_.controller_args.begin(), wires_.controller_args.end());
     }

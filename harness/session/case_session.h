@@ -25,14 +25,6 @@
 
 namespace rig::harness {
 
-// The reliability timers of the harness's DDS context for a case (and of the
-// controller process the session starts, which follows --clock): repair
-// lost samples promptly in real time, wake Fast DDS's threads seldom in
-// lockstep (rig/runtime/dds_context.h).
-inline ReliabilityTimers reliability_timers_for(RunMode mode) {
-    return mode == RunMode::realtime ? ReliabilityTimers::prompt_repair : ReliabilityTimers::few_wakeups;
-}
-
 // The rig's ends of the bench wires a case asks for, and what the controller
 // process must be told to use the far ends.
 struct BenchWires {

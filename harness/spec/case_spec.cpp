@@ -17,9 +17,9 @@ namespace rig::harness {
 
 namespace {
 
-constexpr EnumChoice<RunMode> kRunModes[] = {
-    {"lockstep", RunMode::lockstep},
-    {"realtime", RunMode::realtime},
+constexpr EnumChoice<ClockMode> kClockModes[] = {
+    {"lockstep", ClockMode::lockstep},
+    {"realtime", ClockMode::realtime},
 };
 constexpr EnumChoice<GnssWire> kGnssWires[] = {
     {"dds", GnssWire::dds},
@@ -198,7 +198,7 @@ TimeoutsSpec read_timeouts(const YamlSection& section) {
 
 // The wires, the real-time sections and the board, seed 000's and seed 001's alike.
 void check_bench_wiring(const CaseSpec& spec, const YamlSection& root) {
-    if (spec.wiring.uses_bench_wire() && spec.mode != RunMode::realtime) {
+    if (spec.wiring.uses_bench_wire() && spec.mode != ClockMode::realtime) {
         root.section("wiring").fail("serial, Modbus and HID wires have no virtual time: set `mode: realtime`");
     }
     if (spec.board.line_noise.any() && spec.wiring.board_io != BoardIoWireKind::modbus_rtu) {
@@ -206,7 +206,7 @@ void check_bench_wiring(const CaseSpec& spec, const YamlSection& root) {
                                                  "board_io: modbus_rtu }`");
     }
     for (const char* section : {"realtime", "rig_faults"}) {
-        if (root.has(section) && spec.mode != RunMode::realtime) {
+        if (root.has(section) && spec.mode != ClockMode::realtime) {
             root.fail(section, "bounds and faults of the rig's real-time loop: only with `mode: realtime`");
         }
     }
@@ -222,7 +222,7 @@ void check_common_fields(const CaseSpec& spec, const YamlSection& root) {
         // In process, the controller is stepped by the lockstep master: there is
         // no process boundary, so no wall clock and no bench wire to drive it.
         const YamlSection controller(spec.controller.params);
-        if (spec.mode != RunMode::lockstep || spec.wiring.external_controller) {
+        if (spec.mode != ClockMode::lockstep || spec.wiring.external_controller) {
             controller.fail("in_process", "a controller runs in process only in lockstep cases on DDS wires");
         }
         if (!spec.controller.command.empty() && spec.controller.plugin.empty()) {
@@ -306,7 +306,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
         spec.seed = spec.seeds.front();
     }
     if (root.has("domain")) spec.domain = root.required_in_range<std::uint32_t>("domain", Bounds::closed(0, 232));
-    spec.mode = root.optional_enum<RunMode>("mode", kRunModes, spec.mode);
+    spec.mode = root.optional_enum<ClockMode>("mode", kClockModes, spec.mode);
     const SystemSectionsReader& reader = system_reader(root, systems);
     spec.system = reader.read(root);
     spec.wiring = read_wiring(root.section("wiring"), spec.system->reads_laser_line());
@@ -327,7 +327,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
 
 }  // namespace
 
-std::string_view to_string(RunMode mode) { return name_of(kRunModes, mode); }
+std::string_view to_string(ClockMode mode) { return name_of(kClockModes, mode); }
 std::string_view to_string(GnssWire wire) { return name_of(kGnssWires, wire); }
 std::string_view to_string(BoardIoWireKind wire) { return name_of(kBoardIoWires, wire); }
 

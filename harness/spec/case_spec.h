@@ -28,12 +28,12 @@
 #include "harness/spec/realtime_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
+#include "rig/runtime/clock.h"
 
 namespace rig::harness {
 
-enum class RunMode { lockstep, realtime };
 // The spelling used in case files ("lockstep", "realtime").
-std::string_view to_string(RunMode mode);
+std::string_view to_string(ClockMode mode);
 
 // Positions along a route stay within this of the field origin: no field row
 // is 10 km long, and with the speed at least 0.5 km/h the longest route lasts
@@ -171,7 +171,7 @@ struct CaseSpec {
     // (a faulty controller must be caught on every one).
     std::vector<std::uint64_t> seeds;
     std::string source_text;  // the file as written (kept in the trace)
-    RunMode mode = RunMode::lockstep;
+    ClockMode mode = ClockMode::lockstep;
     // The system's own sections (`system:`; harness/systems/ reads them). Set by
     // the loader for every case it returns.
     std::shared_ptr<const SystemSections> system;

@@ -2,9 +2,16 @@
 
 #include <cerrno>
 #include <ctime>
+#include <stdexcept>
 #include <string>
 
 namespace rig {
+
+ClockMode clock_mode_from(std::string_view text) {
+    if (text == "lockstep") return ClockMode::lockstep;
+    if (text == "realtime") return ClockMode::realtime;
+    throw std::invalid_argument("unknown clock mode '" + std::string(text) + "' (lockstep or realtime)");
+}
 
 RealtimeClock::RealtimeClock() : start_(std::chrono::steady_clock::now()) {}
 

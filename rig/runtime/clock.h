@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <string_view>
 
 namespace rig {
 
@@ -19,6 +20,15 @@ constexpr double ns_to_seconds(TimeNs t) { return static_cast<double>(t) * 1e-9;
 // that runs on a fixed grid (every sample of a 100 Hz device lands on k x 10 ms,
 // whenever the node happened to be woken).
 constexpr TimeNs next_period_boundary(TimeNs now_ns, TimeNs period_ns) { return (now_ns / period_ns + 1) * period_ns; }
+
+// What a case's `mode:` and the controller contract's --clock say: step when
+// the rig's tick says (virtual time), or run on the wall clock from the rig's
+// start tick.
+enum class ClockMode { lockstep, realtime };
+
+// "lockstep" or "realtime"; anything else throws std::invalid_argument
+// naming the text and the two choices.
+ClockMode clock_mode_from(std::string_view text);
 
 class Clock {
 public:

@@ -9,12 +9,6 @@
 
 namespace rig {
 
-ClockMode clock_mode_from(std::string_view text) {
-    if (text == "lockstep") return ClockMode::lockstep;
-    if (text == "realtime") return ClockMode::realtime;
-    throw std::invalid_argument("unknown clock mode '" + std::string(text) + "' (lockstep or realtime)");
-}
-
 ReliabilityTimers reliability_timers_for(ClockMode mode) {
     return mode == ClockMode::realtime ? ReliabilityTimers::prompt_repair : ReliabilityTimers::few_wakeups;
 }

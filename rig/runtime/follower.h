@@ -16,19 +16,12 @@
 #include <optional>
 #include <string_view>
 
+#include "rig/runtime/clock.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/runtime/node.h"
 
 namespace rig {
-
-// What the contract's --clock says: step when the rig's tick says (virtual
-// time), or run on the wall clock from the rig's start tick.
-enum class ClockMode { lockstep, realtime };
-
-// "lockstep" or "realtime"; anything else throws std::invalid_argument
-// naming the text and the two choices.
-ClockMode clock_mode_from(std::string_view text);
 
 // The timers of a follower's context (rig/runtime/dds_context.h): few
 // wake-ups in lockstep, where a lost sample costs only a slower round; prompt
