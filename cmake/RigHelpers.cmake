@@ -49,6 +49,27 @@ function(rig_generate_idl out_var)
   set(${out_var} ${sources} PARENT_SCOPE)
 endfunction()
 
+# Where each ctest entry of a GoogleTest binary writes GoogleTest's XML report
+# (JUnit-like, one <testcase> per test, <skipped message="..."/> for a skip).
+# ctest counts a binary as one test, so a skip inside it would read as passed:
+# scripts/test lists the skipped tests from these files after ctest.
+set(RIG_GTEST_REPORT_DIR ${PROJECT_BINARY_DIR}/gtest-reports)
+
+# rig_add_gtest_run(name binary [args...]): the ctest entry `name` runs the
+# GoogleTest `binary` with `args`; its report goes to RIG_GTEST_REPORT_DIR/name.xml.
+function(rig_add_gtest_run name binary)
+  add_test(NAME ${name} COMMAND ${binary} ${ARGN})
+  # 77: tests/gtest_main.cpp's exit status when every selected test skipped.
+  set_tests_properties(${name} PROPERTIES TIMEOUT 600 SKIP_RETURN_CODE 77)
+  set_property(TEST ${name} APPEND PROPERTY ENVIRONMENT "GTEST_OUTPUT=xml:${RIG_GTEST_REPORT_DIR}/${name}.xml")
+  if(RIG_SANITIZE)
+    # Fast DDS 2.9 deletes its statistics readers through a base pointer of
+    # another size (a library bug, not ours); leaks inside the library are its own.
+    set_property(TEST ${name} APPEND PROPERTY ENVIRONMENT
+      "ASAN_OPTIONS=new_delete_type_mismatch=0:detect_leaks=0")
+  endif()
+endfunction()
+
 # rig_add_test(name SOURCES a.cpp b.cpp LIBS rig::x [LABELS dds]): one GoogleTest
 # executable registered with ctest.  Tests labelled `dds` start DDS participants and
 # are run by scripts/test inside a loopback-only network namespace when allowed.
@@ -67,19 +88,26 @@ function(rig_add_test name)
   else()
     target_compile_options(${name} PRIVATE -O1)
   endif()
-  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
+  # rig_gtest_main (tests/gtest_main.cpp), not GoogleTest's main: it tells ctest
+  # when every test was skipped or none was selected.
+  target_link_libraries(${name} PRIVATE ${T_LIBS} GTest::gtest rig_gtest_main)
   target_compile_definitions(${name} PRIVATE
     RIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     RIG_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  add_test(NAME ${name} COMMAND ${name})
-  set_tests_properties(${name} PROPERTIES TIMEOUT 600)
-  if(RIG_SANITIZE)
-    # Fast DDS 2.9 deletes its statistics readers through a base pointer of
-    # another size (a library bug, not ours); leaks inside the library are its own.
-    set_tests_properties(${name} PROPERTIES ENVIRONMENT
-      "ASAN_OPTIONS=new_delete_type_mismatch=0:detect_leaks=0")
-  endif()
+  rig_add_gtest_run(${name} ${name})
   if(T_LABELS)
     set_tests_properties(${name} PROPERTIES LABELS "${T_LABELS}")
   endif()
+endfunction()
+
+# rig_split_realtime_test(name): the binary `name`'s *RealTime* tests, which run
+# cases on the wall clock, become the ctest entry name_realtime_test (name's
+# "_test" becomes "_realtime_test"), run apart and alone (RUN_SERIAL) so the
+# other suites' load does not become their scheduling jitter, as `rig run` runs
+# real-time cases alone after the lockstep ones; `name` runs the rest.
+function(rig_split_realtime_test name)
+  string(REGEX REPLACE "_test$" "_realtime_test" realtime ${name})
+  set_property(TEST ${name} APPEND PROPERTY ENVIRONMENT_MODIFICATION "GTEST_FILTER=set:-*RealTime*")
+  rig_add_gtest_run(${realtime} ${name} --gtest_filter=*RealTime*)
+  set_tests_properties(${realtime} PROPERTIES LABELS "dds;realtime" RUN_SERIAL TRUE)
 endfunction()

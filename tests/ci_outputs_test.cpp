@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "run_support.h"
+#include "tool_support.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -42,6 +43,7 @@ int rig(const std::string& args, const fs::path& log) {
 
 // xmllint's verdict on `xml` against the Jenkins schema: its exit status (0: valid).
 int xmllint_schema(const fs::path& xml, const fs::path& log) {
+    EXPECT_TRUE(rig::testing::tool_installed("xmllint", "libxml2-utils"));
     return run_logged("xmllint --noout --schema '" + kSchema.string() + "' '" + xml.string() + "'", log);
 }
 

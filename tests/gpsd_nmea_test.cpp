@@ -37,6 +37,7 @@
 #include "rig/host/child_process.h"
 #include "rig/runtime/clock.h"
 #include "rig/wire/pty_pair.h"
+#include "tool_support.h"
 
 namespace rig {
 namespace {
@@ -87,13 +88,6 @@ std::string iso_time(const nmea::GnssFix& fix) {
     std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02ld:%02ld:%02ld.%03ldZ", fix.year, fix.month, fix.day,
                   centiseconds / 360000, centiseconds / 6000 % 60, centiseconds / 100 % 60, centiseconds % 100 * 10);
     return text;
-}
-
-std::string find_program(const std::vector<std::string>& candidates) {
-    for (const auto& candidate : candidates) {
-        if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-    }
-    return {};
 }
 
 int free_loopback_port() {
@@ -165,8 +159,8 @@ std::string read_file(const fs::path& path) {
 }
 
 TEST(GpsdReadsRigNmea, TpvReportsCarryTheWrittenPositionsAndTimes) {
-    const std::string gpsd_program = find_program({"/usr/sbin/gpsd", "/usr/bin/gpsd", "/sbin/gpsd"});
-    ASSERT_FALSE(gpsd_program.empty()) << "gpsd is not installed (Debian package gpsd, scripts/debian-packages.txt)";
+    ASSERT_TRUE(rig::testing::tool_installed("gpsd", "gpsd"));
+    const std::string gpsd_program = rig::testing::installed_program("gpsd");
 
     const fs::path dir = fs::path(::testing::TempDir()) / "gpsd-nmea";
     fs::remove_all(dir);

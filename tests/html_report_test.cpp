@@ -4,6 +4,7 @@
 // RIG_SAMPLE_REPORT=FILE keeps a copy of the sample page to look at.
 #include "harness/report/html_report.h"
 #include "harness/systems/breakpoint/breakpoint_figures.h"
+#include "tool_support.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -174,13 +175,12 @@ protected:
         const int status = std::system(command.c_str());
         return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }
-    static bool have(const std::string& program) { return shell("command -v " + program + " >/dev/null 2>&1") == 0; }
 
     fs::path dir_;
 };
 
 TEST_F(HtmlReportTest, DrawsFiguresEscapesNamesShowsErrorsAndIsWellFormed) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed (scripts/debian-packages.txt: gnuplot-nox)";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     const Suite suite = synthetic_suite();
     const fs::path file = dir_ / "report.html";
     const std::vector<std::string> problems =
@@ -228,7 +228,7 @@ TEST_F(HtmlReportTest, DrawsFiguresEscapesNamesShowsErrorsAndIsWellFormed) {
     EXPECT_NE(page.find("130.5 s</td><td class=\"num\">12.7 s</td><td class=\"num\">10.3\u00d7"), std::string::npos);
 
     // Well-formed as XML as a whole (the SVGs included), so as polyglot XHTML.
-    if (!have("xmllint")) GTEST_SKIP() << "xmllint is not installed (scripts/debian-packages.txt: libxml2-utils)";
+    ASSERT_TRUE(rig::testing::tool_installed("xmllint", "libxml2-utils"));
     EXPECT_EQ(shell("xmllint --noout '" + file.string() + "'"), 0);
     // And each inlined SVG alone.
     // (A plain search: std::regex recurses per character and overflows the stack
@@ -247,7 +247,7 @@ TEST_F(HtmlReportTest, DrawsFiguresEscapesNamesShowsErrorsAndIsWellFormed) {
 }
 
 TEST_F(HtmlReportTest, SameInputsGiveTheSameBytes) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     const Suite suite = synthetic_suite();
     write_html_report(dir_ / "first.html", suite.results, suite.figures, summarize(suite.results));
     write_html_report(dir_ / "second.html", suite.results, suite.figures, summarize(suite.results));
@@ -278,9 +278,9 @@ TEST_F(HtmlReportTest, MissingGnuplotStillWritesTheReportWithTheReason) {
     // The tables are all there.
     EXPECT_EQ(count(page, "<figure class=\"figure flow\""), 2u);
     EXPECT_NE(page.find("<td class=\"mono\">flow_error_pct</td>"), std::string::npos);
-    if (have("xmllint")) {
-        EXPECT_EQ(shell("xmllint --noout '" + (dir_ / "report.html").string() + "'"), 0);
-    }
+    // Well-formed without its figures too.
+    ASSERT_TRUE(rig::testing::tool_installed("xmllint", "libxml2-utils"));
+    EXPECT_EQ(shell("xmllint --noout '" + (dir_ / "report.html").string() + "'"), 0);
 }
 
 // A stand-in for gnuplot: refuses the all-panels batch (so each panel is drawn
@@ -297,7 +297,7 @@ fs::path gnuplot_wrapper(const fs::path& dir, const std::string& bad_text) {
 }
 
 TEST_F(HtmlReportTest, PanelsDrawnOneByOneAreTheSameAsInOneBatch) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     const Suite suite = synthetic_suite();
     const std::vector<std::string> batch_problems =
         write_html_report(dir_ / "batch.html", suite.results, suite.figures, summarize(suite.results));
@@ -311,7 +311,7 @@ TEST_F(HtmlReportTest, PanelsDrawnOneByOneAreTheSameAsInOneBatch) {
 }
 
 TEST_F(HtmlReportTest, AFailingPanelSpoilsOnlyItself) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     const Suite suite = synthetic_suite();
     HtmlReportOptions options;
     options.gnuplot = gnuplot_wrapper(dir_, "Normalised total dose").string();
@@ -343,7 +343,7 @@ TEST_F(HtmlReportTest, AStuckGnuplotIsStoppedAtTheTimeLimit) {
 }
 
 TEST_F(HtmlReportTest, CaseNamesAreNeverCode) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     Suite suite = synthetic_suite();
     suite.results.resize(1);
     suite.figures.resize(1);
@@ -359,7 +359,7 @@ TEST_F(HtmlReportTest, CaseNamesAreNeverCode) {
 }
 
 TEST_F(HtmlReportTest, LongTracesAreThinnedForThePage) {
-    if (!have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed";
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     Suite suite = synthetic_suite();
     suite.results.resize(1);
     suite.figures.resize(1);

@@ -21,6 +21,7 @@
 #include "harness/trace/mcap_writer.h"
 #include "harness/trace/trace_mcap.h"
 #include "run_support.h"
+#include "tool_support.h"
 
 namespace fs = std::filesystem;
 using rig::testing::fresh_dir;
@@ -73,6 +74,33 @@ std::string meta_value(const fs::path& trace, const std::string& key) {
     return text;
 }
 
+// The forging case never records a forged sample: the rig refuses the forger
+// at t = 0, when its hello or discovery shows its truth/hydraulics writer,
+// before any sample of it arrives. So the test adds two to the trace, as the
+// recorder would have written them (TraceFile::append_foreign): from node
+// 'controller', the participant the case's error names (with a made-up GUID
+// prefix, as discovery may not have seen it), each a copy of one of the
+// plant's own truth/hydraulics samples in `donor` (the forger sends the
+// plant's type). Forged samples are outside the trace's digest, which stays
+// valid. Returns how many were added.
+int forge_samples(const fs::path& trace, const fs::path& donor) {
+    sqlite3* db = nullptr;
+    EXPECT_EQ(sqlite3_open_v2(trace.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+    char* sql = sqlite3_mprintf(
+        "ATTACH DATABASE %Q AS donor;"
+        "INSERT INTO foreign_samples (t_ns, round, topic, participant, guid_prefix, json)"
+        " SELECT t_ns, round, topic, 'controller', '0f0f0f0f0f0f0f0f0f0f0f0f', json FROM donor.samples"
+        " WHERE topic = 'truth/hydraulics' ORDER BY t_ns LIMIT 2;",
+        donor.c_str());
+    char* error = nullptr;
+    EXPECT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
+    sqlite3_free(error);
+    sqlite3_free(sql);
+    const int added = sqlite3_changes(db);
+    sqlite3_close(db);
+    return added;
+}
+
 }  // namespace
 
 TEST(McapWriter, Crc32IsTheIeeeCrcOfTheSpecification) {
@@ -101,9 +129,12 @@ TEST(McapWriter, TheSchemaCoversEveryShapeASampleTook) {
 }
 
 // A run with many samples and a run with a forger: the official reader
-// finds every sample, in time order, on a channel with a JSON schema; the
-// summary's statistics and the streamed read agree; the trace's meta is there.
+// finds every sample, in time order, on a channel with a JSON schema, the
+// forged ones on a channel of their own; the summary's statistics and the
+// streamed read agree; the trace's meta is there.
 TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
+    ASSERT_TRUE(rig::testing::tool_installed("node", "nodejs"));
+    ASSERT_TRUE(rig::testing::tool_installed("sqlite3", "sqlite3"));
     const fs::path dir = fresh_dir("mcap-official-reader");
     const fs::path out = dir / "out";
     const auto run = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " run " +
@@ -111,11 +142,13 @@ TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
                             quoted(RIG_SOURCE_DIR "/cases/faulty-controllers/forges-truth-topic.yaml") +
                             " --out " + quoted(out));
     ASSERT_EQ(run.exit_code, 0) << run.output;
+    const fs::path forged_trace = out / "cases" / "forges-truth-topic-seed1" / "trace.sqlite";
+    ASSERT_EQ(forge_samples(forged_trace, out / "cases" / "continuation-6kmh" / "trace.sqlite"), 2);
     const auto mcap = shell(quoted(RIG_BINARY_DIR "/bin/rig") + " mcap " + quoted(out));
     ASSERT_EQ(mcap.exit_code, 0) << mcap.output;
 
     std::size_t traces = 0;
-    bool saw_foreign = false, forged_in_trace = false;
+    std::size_t forged_in_trace = 0, forged_in_mcap = 0;
     for (const std::string name : {"continuation-6kmh", "forges-truth-topic-seed1"}) {
         SCOPED_TRACE(name);
         const fs::path case_dir = out / "cases" / name;
@@ -134,12 +167,12 @@ TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
                                      << read.output;
         const nlohmann::json summary = nlohmann::json::parse(read.output);
         const std::vector<std::string> expected = trace_lines(trace);
-        // The forging case ends when discovery shows the forger, after as many samples as the wall clock allowed.
+        // The forging case ends at t = 0 (see forge_samples): its trace holds the forged samples alone.
         if (name == "continuation-6kmh") {
             ASSERT_GT(expected.size(), 20000u);
         }
         for (const std::string& line : expected) {
-            if (line.find("\tforeign/") != std::string::npos) forged_in_trace = true;
+            if (line.find("\tforeign/") != std::string::npos) ++forged_in_trace;
         }
         const std::vector<std::string> got = sorted_lines(read_all(lines_file));
         EXPECT_EQ(got.size(), expected.size());
@@ -154,11 +187,16 @@ TEST(McapOfficialReader, ReadsEverySampleOfTheTraces) {
         EXPECT_TRUE(summary["streamed"]["done"].get<bool>());
         EXPECT_EQ(summary["metadata"]["rig.trace.meta"]["trace_sha256"], meta_value(trace, "trace_sha256"));
         for (const auto& [topic, count] : indexed["byTopic"].items()) {
-            if (topic.rfind("foreign/", 0) == 0) saw_foreign = true;
+            if (topic.rfind("foreign/", 0) == 0) forged_in_mcap += count.get<std::size_t>();
+        }
+        if (name == "forges-truth-topic-seed1") {
+            EXPECT_GE(indexed["byTopic"].value("foreign/controller/truth/hydraulics", 0), 2) << indexed.dump(2);
         }
     }
     EXPECT_EQ(traces, 2u);
-    EXPECT_EQ(saw_foreign, forged_in_trace) << "a forged sample's channel";
+    // Forged samples in the trace, and each in the MCAP on its foreign channel.
+    EXPECT_GE(forged_in_trace, 2u);
+    EXPECT_EQ(forged_in_mcap, forged_in_trace) << "a forged sample's channel";
 }
 
 // Not a trace, a missing file, --out with several traces: clear errors naming

@@ -51,13 +51,19 @@ std::string read_page() {
     return text.str();
 }
 
-// The page's number for a named row (first word of its second cell); NaN when absent.
-double documented(const std::vector<std::vector<std::string>>& rows, const std::string& name) {
+// The second cell of the page's row named `name`; a failure, and "", when the page has no such row.
+std::string documented_text(const std::vector<std::vector<std::string>>& rows, const std::string& name) {
     for (const auto& row : rows) {
-        if (row.size() >= 2 && row[0] == name) return std::stod(row[1]);
+        if (row.size() >= 2 && row[0] == name) return row[1];
     }
     ADD_FAILURE() << "docs/modbus-register-map.md has no row '" << name << "'";
-    return std::nan("");
+    return "";
+}
+
+// The page's number for a named row (first word of its second cell); NaN when absent.
+double documented(const std::vector<std::vector<std::string>>& rows, const std::string& name) {
+    const std::string text = documented_text(rows, name);
+    return text.empty() ? std::nan("") : std::stod(text);
 }
 
 // Equal to the shown precision: relative 1e-4 (the page rounds derived values to 4 significant digits).
@@ -125,9 +131,5 @@ TEST(RegisterMapDoc, TheBoardKeysDefaultsAreTheCodes) {
     expect_documented(rows, "board.attach_timeout_s", board.attach_timeout_s);
     expect_documented(rows, "board.silence_timeout_s", board.silence_timeout_s);
     expect_documented(rows, "board.failsafe_timeout_s", board.failsafe_timeout_s);
-    for (const auto& row : rows) {
-        if (row.size() >= 2 && row[0] == "board.failsafe") {
-            EXPECT_EQ(row[1], std::string(rig::modbus::to_string(board.failsafe)));
-        }
-    }
+    EXPECT_EQ(documented_text(rows, "board.failsafe"), std::string(rig::modbus::to_string(board.failsafe)));
 }

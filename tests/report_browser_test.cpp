@@ -15,6 +15,7 @@
 #include <string>
 
 #include "run_support.h"
+#include "tool_support.h"
 
 namespace fs = std::filesystem;
 using rig::testing::fresh_dir;
@@ -31,6 +32,10 @@ constexpr double kSmallestLegiblePx = 9.0;
 }  // namespace
 
 TEST(ReportInABrowser, ReadableAtPhoneAndDesktopWidthWithoutErrors) {
+    // check_report.mjs launches /usr/bin/chromium through node; the figures are gnuplot's.
+    ASSERT_TRUE(rig::testing::tool_installed("node", "nodejs"));
+    ASSERT_TRUE(rig::testing::tool_installed("chromium", "chromium"));
+    ASSERT_TRUE(rig::testing::tool_installed("gnuplot", "gnuplot-nox"));
     const fs::path dir = fresh_dir("report-browser");
     const fs::path out = dir / "out";
     // A passing continuation, a failing faulty controller and a seed-001 vision

@@ -4,6 +4,7 @@
 #include "harness/output/atomic_file.h"
 #include "harness/output/xml_text.h"
 #include "harness/report/results_writer.h"
+#include "tool_support.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -387,8 +388,12 @@ TEST(JunitXml, IsWellFormedAndEscaped) {
 
 // The same odd names and error text, against the schema Jenkins's xunit plugin
 // checks JUnit files with (xmllint from libxml2-utils, which scripts/setup installs).
-// xmllint's verdict on `text` against the Jenkins schema: "" when it validates, else what it said.
+// xmllint's verdict on `text` against the Jenkins schema: "" when it validates, else what it said
+// (or that xmllint is missing).
 std::string schema_problems(const std::string& text) {
+    if (const auto installed = rig::testing::tool_installed("xmllint", "libxml2-utils"); !installed) {
+        return installed.message();
+    }
     const fs::path xml = fs::temp_directory_path() / ("results_writer_test_junit_" + std::to_string(::getpid()) + ".xml");
     std::ofstream(xml) << text;
     const std::string command = "xmllint --noout --schema '" RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd' '" +

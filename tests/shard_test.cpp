@@ -14,6 +14,7 @@
 
 #include "harness/run/shard.h"
 #include "run_support.h"
+#include "tool_support.h"
 
 namespace fs = std::filesystem;
 using rig::harness::parse_shard;
@@ -115,6 +116,7 @@ TEST(ShardAndMerge, TheMergedShardsAreTheSuiteRunAtOnce) {
     }
     for (const char* file : {"junit.xml", "report.txt", "report.html"}) EXPECT_TRUE(fs::exists(dir / "merged" / file)) << file;
     // The merged junit.xml is CI-grade like a run's (ci_outputs_test holds the run's).
+    ASSERT_TRUE(rig::testing::tool_installed("xmllint", "libxml2-utils"));
     const auto schema = run_shell("xmllint --noout --schema " + quoted(RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd") +
                                   " " + quoted(dir / "merged" / "junit.xml") + " 2>&1");
     EXPECT_EQ(schema.exit_code, 0) << schema.output;
