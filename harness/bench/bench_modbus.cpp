@@ -6,15 +6,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <iostream>
 #include <mutex>
 #include <numbers>
 #include <optional>
-#include <sstream>
 
 #include "rig/runtime/clock.h"
 #include "rig/wire/modbus_slave.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 namespace {
@@ -29,11 +28,7 @@ std::uint32_t wrapped_count(double count) {
     return static_cast<std::uint32_t>(wrapped < 0 ? wrapped + kWrap : wrapped);
 }
 
-std::string seconds_text(TimeNs ns) {
-    std::ostringstream text;
-    text << std::fixed << std::setprecision(3) << ns_to_seconds(ns);
-    return text.str();
-}
+std::string seconds_text(TimeNs ns) { return fixed_text(ns_to_seconds(ns), 3); }
 
 std::string commands_line(const io::ActuatorCommands& commands) {
     std::string sections;

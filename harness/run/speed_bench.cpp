@@ -23,6 +23,7 @@
 #include "rig/host/cpu_lease.h"
 #include "rig/runtime/dds_security.h"
 #include "rig/runtime/thread_id_cache.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 namespace {
@@ -145,12 +146,6 @@ std::string load_average() {
     std::string one, five, fifteen;
     in >> one >> five >> fifteen;
     return in ? one + " " + five + " " + fifteen : std::string("unknown");
-}
-
-std::string fixed(double value, int digits) {
-    std::ostringstream text;
-    text << std::fixed << std::setprecision(digits) << value;
-    return text.str();
 }
 
 }  // namespace
@@ -296,25 +291,25 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     out << "rig bench: " << specs.size() << " case(s), " << options.repeat << " run(s) per case and mode, one at a time; "
         << std::thread::hardware_concurrency() << " cores; load average " << load_before << " before, "
         << load_average() << " after\n";
-    out << "  simulated per case " << fixed(sim_per_case, 1) << " s; " << fixed(process.rounds_per_sim_s, 1)
+    out << "  simulated per case " << fixed_text(sim_per_case, 1) << " s; " << fixed_text(process.rounds_per_sim_s, 1)
         << " rounds per simulated second; trace digests "
         << (digests_equal ? "identical in every run of every mode" : "DIFFER (see above)") << "\n\n";
     out << "                                      us/round  rounds/s  x real time  start-up p50/p99 s  trace KB/sim-min  "
            "vs floor\n";
     auto floor_row = [&](const char* label, const FloorFigures& f) {
-        out << "  " << label << std::setw(8) << fixed(f.result.p50_us, 1) << "  " << std::setw(8)
-            << fixed(1e6 / std::max(f.result.p50_us, 1e-9), 0) << "  " << std::setw(11) << "-" << "  " << std::setw(18)
-            << (fixed(f.result.matched_after_s, 3) + " (match)") << "  " << std::setw(16) << "-" << "  "
-            << std::setw(8) << "1.00" << "   (p99 " << fixed(f.result.p99_us, 1) << " us; " << f.p50s.size() << " x "
-            << f.result.rounds << " round trips, one before each repeat: p50 " << fixed(percentile(f.p50s, 0.0), 1)
-            << "-" << fixed(percentile(f.p50s, 1.0), 1) << " us)\n";
+        out << "  " << label << std::setw(8) << fixed_text(f.result.p50_us, 1) << "  " << std::setw(8)
+            << fixed_text(1e6 / std::max(f.result.p50_us, 1e-9), 0) << "  " << std::setw(11) << "-" << "  " << std::setw(18)
+            << (fixed_text(f.result.matched_after_s, 3) + " (match)") << "  " << std::setw(16) << "-" << "  "
+            << std::setw(8) << "1.00" << "   (p99 " << fixed_text(f.result.p99_us, 1) << " us; " << f.p50s.size() << " x "
+            << f.result.rounds << " round trips, one before each repeat: p50 " << fixed_text(percentile(f.p50s, 0.0), 1)
+            << "-" << fixed_text(percentile(f.p50s, 1.0), 1) << " us)\n";
     };
     auto row = [&](const char* label, const ModeFigures& f, double ratio) {
-        out << "  " << label << std::setw(8) << fixed(f.us_per_round, 1) << "  " << std::setw(8)
-            << fixed(f.rounds_per_s, 0) << "  " << std::setw(11) << fixed(f.x_real_time, 1) << "  " << std::setw(18)
-            << (fixed(f.startup_p50_s, 3) + " / " + fixed(f.startup_p99_s, 3)) << "  " << std::setw(16)
-            << fixed(f.trace_bytes_per_sim_minute / 1024.0, 1) << "  " << std::setw(8)
-            << fixed(ratio, 2) << "\n";
+        out << "  " << label << std::setw(8) << fixed_text(f.us_per_round, 1) << "  " << std::setw(8)
+            << fixed_text(f.rounds_per_s, 0) << "  " << std::setw(11) << fixed_text(f.x_real_time, 1) << "  " << std::setw(18)
+            << (fixed_text(f.startup_p50_s, 3) + " / " + fixed_text(f.startup_p99_s, 3)) << "  " << std::setw(16)
+            << fixed_text(f.trace_bytes_per_sim_minute / 1024.0, 1) << "  " << std::setw(8)
+            << fixed_text(ratio, 2) << "\n";
     };
     floor_row("DDS ping-pong, 2 processes, 1 CPU  ", pinned_floor);
     row("process mode, 1 CPU (default)      ", process, process_ratio);
@@ -325,16 +320,16 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     std::optional<ModeFigures> secured;
     if (credentials) {
         secured = figures_of(modes[3].runs);
-        out << "  DDS ping-pong, DDS-Security, 1 CPU" << std::setw(8) << fixed(secured_floor->p50_us, 1) << "  "
-            << std::setw(8) << fixed(1e6 / std::max(secured_floor->p50_us, 1e-9), 0) << "  " << std::setw(11) << "-"
-            << "  " << std::setw(18) << (fixed(secured_floor->matched_after_s, 3) + " (match)") << "  "
+        out << "  DDS ping-pong, DDS-Security, 1 CPU" << std::setw(8) << fixed_text(secured_floor->p50_us, 1) << "  "
+            << std::setw(8) << fixed_text(1e6 / std::max(secured_floor->p50_us, 1e-9), 0) << "  " << std::setw(11) << "-"
+            << "  " << std::setw(18) << (fixed_text(secured_floor->matched_after_s, 3) + " (match)") << "  "
             << std::setw(16) << "-" << "  " << std::setw(8)
-            << fixed(secured_floor->p50_us / std::max(pinned_floor.result.p50_us, 1e-9), 2) << "   (p99 "
-            << fixed(secured_floor->p99_us, 1) << " us, " << secured_floor->rounds << " round trips)\n";
+            << fixed_text(secured_floor->p50_us / std::max(pinned_floor.result.p50_us, 1e-9), 2) << "   (p99 "
+            << fixed_text(secured_floor->p99_us, 1) << " us, " << secured_floor->rounds << " round trips)\n";
         row("process mode, DDS-Security, 1 CPU  ", *secured,
             secured->us_per_round / std::max(pinned_floor.result.p50_us, 1e-9));
-        out << "  DDS-Security costs " << fixed(secured->us_per_round - process.us_per_round, 1)
-            << " us per round in process mode (" << fixed(secured_floor->p50_us - pinned_floor.result.p50_us, 1)
+        out << "  DDS-Security costs " << fixed_text(secured->us_per_round - process.us_per_round, 1)
+            << " us per round in process mode (" << fixed_text(secured_floor->p50_us - pinned_floor.result.p50_us, 1)
             << " us per ping-pong round trip)\n";
     }
     out << "\n  us/round: stepping wall time / rounds (a round: the rig's nodes, a tick to the controller, its "
@@ -356,13 +351,13 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     const double in_process_switches_per_round = per_round(modes[2].context_switches, in_process.rounds);
     out << "  context switches a round (both processes, every thread; a case's start-up and judging included):\n"
            "    1 CPU: ping-pong "
-        << fixed(floor_switches_pinned_per_round, 1) << ", process mode " << fixed(process_switches_per_round, 1)
-        << ", SIL " << fixed(in_process_switches_per_round, 1) << "; any CPU: ping-pong "
-        << fixed(floor_switches_free_per_round, 1) << ", process mode " << fixed(process_unpinned_switches_per_round, 1)
+        << fixed_text(floor_switches_pinned_per_round, 1) << ", process mode " << fixed_text(process_switches_per_round, 1)
+        << ", SIL " << fixed_text(in_process_switches_per_round, 1) << "; any CPU: ping-pong "
+        << fixed_text(floor_switches_free_per_round, 1) << ", process mode " << fixed_text(process_unpinned_switches_per_round, 1)
         << "\n";
     if (process.us_per_round > 0.0 && pinned_floor.result.p50_us > 0.0) {
-        out << "  one CPU against any CPU: process mode " << fixed(process_unpinned.us_per_round / process.us_per_round, 2)
-            << "x as fast a round, the ping-pong " << fixed(free_floor.result.p50_us / pinned_floor.result.p50_us, 2)
+        out << "  one CPU against any CPU: process mode " << fixed_text(process_unpinned.us_per_round / process.us_per_round, 2)
+            << "x as fast a round, the ping-pong " << fixed_text(free_floor.result.p50_us / pinned_floor.result.p50_us, 2)
             << "x\n";
     }
 

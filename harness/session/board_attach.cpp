@@ -3,15 +3,14 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <iomanip>
 #include <ostream>
-#include <sstream>
 #include <system_error>
 
 #include "harness/output/atomic_file.h"
 #include "harness/session/line_noise.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/wire/modbus_slave.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 
@@ -25,11 +24,7 @@ constexpr const char* kFirstRequest = "its first valid Modbus request addressed 
 constexpr const char* kPtyOpened = "a process other than the rig opens the pty";
 constexpr const char* kNotObservable = "not observable (a serial device's transmit line)";
 
-std::string seconds_text(double seconds, int decimals = 2) {
-    std::ostringstream text;
-    text << std::fixed << std::setprecision(decimals) << seconds;
-    return text.str();
-}
+std::string seconds_text(double seconds, int decimals = 2) { return fixed_text(seconds, decimals); }
 
 std::string line_settings(int baud) { return std::to_string(baud) + " 8N1"; }
 
