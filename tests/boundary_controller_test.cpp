@@ -1,7 +1,8 @@
 // Seed 001's reference controller logic, positioning and boundary half
 // (controller/boundary/): UTM zone, Eq. 14 levels, Eq. 18 and 19, the two
 // shut-off rules of Sec. 4.2 on drives across an area's edge, the look-ahead
-// option, and hostile input. RMC sentences are written with the emulators'
+// option, hostile input, and the node's duty commands (DutyCommandDelay, with
+// the TEST-ONLY late fault). RMC sentences are written with the emulators'
 // encoder from positions in the field's local frame (the plant's truth), so the
 // controller's UTM and grid-convergence handling are exercised for real.
 #include <gtest/gtest.h>
@@ -17,6 +18,7 @@
 
 #include "controller/boundary/boundary_controller.h"
 #include "controller/boundary/boundary_equations.h"
+#include "controller/boundary/duty_command_delay.h"
 #include "controller/boundary/utm_area.h"
 #include "emulators/field2d/local_frame.h"
 #include "emulators/field2d/vec2.h"
@@ -438,6 +440,41 @@ TEST(BoundaryController, BadConfigurationIsRejectedByName) {
     c = square_config();
     c.default_boom_height_m = 2.0;
     expect_bad(c, "default_boom_height_m");
+    c = square_config();
+    c.faults.command_delay_s = -0.1;
+    expect_bad(c, "faults.command_delay_s");
+}
+
+TEST(DutyCommandDelay, WithoutDelayEachChangeGoesOutInTheStepThatDecidedIt) {
+    DutyCommandDelay commands(0);
+    const std::vector<double> open(6, 100.0);
+    const std::vector<double> shut(6, 0.0);
+    commands.decide(shut, 0);  // the first command goes out, whatever it says
+    EXPECT_EQ(commands.take_due(0), std::vector<std::vector<double>>{shut});
+    commands.decide(shut, seconds_to_ns(0.1));  // unchanged: nothing to send
+    EXPECT_TRUE(commands.take_due(seconds_to_ns(0.1)).empty());
+    EXPECT_EQ(commands.next_due_ns(), rig::kNever);
+    commands.decide(open, seconds_to_ns(0.2));
+    EXPECT_EQ(commands.take_due(seconds_to_ns(0.2)), std::vector<std::vector<double>>{open});
+}
+
+TEST(DutyCommandDelay, TheLateFaultSendsEveryChangeInOrderTheDelayAfterItsDecision) {
+    // 0.3 s late: the changes decided at 1.0 and 1.1 s go out at 1.3 and 1.4 s,
+    // both, in order, though the second was decided before the first went out.
+    DutyCommandDelay commands(seconds_to_ns(0.3));
+    const std::vector<double> open(6, 100.0);
+    const std::vector<double> half{100, 100, 100, 0, 0, 0};
+    const std::vector<double> shut(6, 0.0);
+    commands.decide(open, seconds_to_ns(0.5));
+    commands.decide(half, seconds_to_ns(1.0));
+    commands.decide(shut, seconds_to_ns(1.1));
+    EXPECT_EQ(commands.next_due_ns(), seconds_to_ns(0.8));
+    EXPECT_TRUE(commands.take_due(seconds_to_ns(0.8) - 1).empty());
+    EXPECT_EQ(commands.take_due(seconds_to_ns(1.2)), std::vector<std::vector<double>>{open});
+    EXPECT_EQ(commands.next_due_ns(), seconds_to_ns(1.3));
+    EXPECT_EQ(commands.take_due(seconds_to_ns(1.4)), (std::vector<std::vector<double>>{half, shut}));
+    EXPECT_EQ(commands.next_due_ns(), rig::kNever);
+    EXPECT_THROW(DutyCommandDelay(-1), std::invalid_argument);
 }
 
 }  // namespace
