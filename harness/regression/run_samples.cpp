@@ -50,7 +50,9 @@ RunSample sample_of(const nlohmann::json& run, std::uint64_t seed, const std::st
     sample.controller_sha256 = text_or_empty(run, "controller_sha256");
     sample.controller_config_sha256 = text_or_empty(run, "controller_config_sha256");
     if (run.contains("metrics") && !run.at("metrics").is_object()) throw std::runtime_error("metrics is not an object");
-    for (const auto& [metric, value] : run.value("metrics", nlohmann::json::object()).items()) {
+    // Held by name: items() of the temporary value() returns would outlive it in the loop (C++20).
+    const nlohmann::json metrics = run.value("metrics", nlohmann::json::object());
+    for (const auto& [metric, value] : metrics.items()) {
         if (value.is_null()) {
             sample.not_measured[metric] = "no value (NaN)";
         } else if (value.is_number()) {
@@ -118,6 +120,9 @@ RunSamples run_samples_from_json(const nlohmann::json& json, const std::string& 
     if (json.contains("rig") && json.at("rig").is_object()) {
         samples.rig_version = text_or_empty(json.at("rig"), "version");
         samples.rig_commit = text_or_empty(json.at("rig"), "commit");
+    }
+    if (json.contains("started_utc") && json.at("started_utc").is_string()) {
+        samples.started_utc = json.at("started_utc").get<std::string>();
     }
     std::map<std::string, CaseSamples> cases;
     const nlohmann::json& listed = json.at("cases");
