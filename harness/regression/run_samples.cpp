@@ -50,7 +50,6 @@ RunSample sample_of(const nlohmann::json& run, std::uint64_t seed, const std::st
     sample.controller_sha256 = text_or_empty(run, "controller_sha256");
     sample.controller_config_sha256 = text_or_empty(run, "controller_config_sha256");
     if (run.contains("metrics") && !run.at("metrics").is_object()) throw std::runtime_error("metrics is not an object");
-    // Held by name: items() of the temporary value() returns would outlive it in the loop (C++20).
     const nlohmann::json metrics = run.value("metrics", nlohmann::json::object());
     for (const auto& [metric, value] : metrics.items()) {
         if (value.is_null()) {
