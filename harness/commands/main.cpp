@@ -3,6 +3,7 @@
 //   rig run, rig sweep          harness/commands/run_command.h
 //   rig judge, rig merge        harness/commands/judge_command.h
 //   rig diff                    harness/commands/diff_command.h
+//   rig compare                 harness/commands/compare_command.h
 //   rig bench                   harness/commands/bench_command.h
 //   rig dds-check               harness/commands/dds_check_command.h
 //   rig mcap                    harness/commands/mcap_command.h
@@ -24,6 +25,7 @@
 #include "harness/bench/bench_serial.h"
 #include "harness/bench/nmea_decode_tool.h"
 #include "harness/commands/bench_command.h"
+#include "harness/commands/compare_command.h"
 #include "harness/commands/dds_check_command.h"
 #include "harness/commands/diff_command.h"
 #include "harness/commands/judge_command.h"
@@ -123,6 +125,7 @@ int main(int argc, char** argv) {
     commands.push_back(std::make_unique<MergeCommand>(app));
     commands.push_back(std::make_unique<DiffCommand>(app));
     commands.push_back(std::make_unique<SweepCommand>(app));
+    commands.push_back(std::make_unique<CompareCommand>(app));
     commands.push_back(std::make_unique<NmeaCommand>(app));
     commands.push_back(std::make_unique<PtyBenchCommand>(app));
     commands.push_back(std::make_unique<HidBenchCommand>(app));
