@@ -96,6 +96,17 @@ TEST_F(RigDiff, OneSeedAndTheSameControllerIsTheSameBehaviour) {
     const auto traces = rig("diff " + quoted(trace("same-1")) + " " + quoted(trace("same-2")));
     EXPECT_EQ(traces.exit_code, 0) << traces.output;
     EXPECT_TRUE(says_all(traces.output, {"same behaviour", "judged from its trace", "flow_adjust_time_s"}));
+
+    // A case's directory names its trace; a run directory without results.json
+    // (a sweep's) its cases.
+    const auto case_dirs = rig("diff " + quoted(trace("same-1").parent_path()) + " " + quoted(trace("same-2").parent_path()));
+    EXPECT_EQ(case_dirs.exit_code, 0) << case_dirs.output;
+    const fs::path without_results = *dir_ / "same-2-without-results";
+    fs::create_directories(without_results / "cases");
+    fs::copy(run("same-2") / "cases", without_results / "cases", fs::copy_options::recursive);
+    const auto without = rig("diff " + quoted(run("same-1")) + " " + quoted(without_results));
+    EXPECT_EQ(without.exit_code, 0) << without.output;
+    EXPECT_TRUE(says(without.output, "metrics (A: its results.json; B: judged from its trace)"));
 }
 
 TEST_F(RigDiff, AChangedControllerIsNamedByTheFirstActuatorTopicThatPartsAndItsInstant) {
@@ -185,7 +196,7 @@ TEST_F(RigDiff, BadInputIsRefusedNamingWhatAndWhere) {
 
     refused = rig("diff " + quoted(run("same-1")) + " " + quoted(trace("same-2")));
     EXPECT_EQ(refused.exit_code, 2) << refused.output;
-    EXPECT_TRUE(says(refused.output, "is a directory and"));
+    EXPECT_TRUE(says(refused.output, "is a run directory and"));
 
     refused = rig("diff " + quoted(run("same-1")) + " " + quoted(run("same-2")) + " no-such-case");
     EXPECT_EQ(refused.exit_code, 2) << refused.output;

@@ -42,23 +42,38 @@ struct Side {
     RecordedTrace trace;
 };
 
-nlohmann::json results_of_run(const fs::path& dir) {
-    const fs::path file = dir / "results.json";
-    std::ifstream in(file);
-    if (!in) throw std::runtime_error(dir.string() + ": no results.json in it (not a rig run --out directory?)");
-    nlohmann::json results = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (results.is_discarded() || !results.is_object() || !results.contains("cases") || !results["cases"].is_array()) {
-        throw std::runtime_error(file.string() + ": not a results.json of rig run (no cases list)");
-    }
-    return results;
-}
+// A `rig run` or `rig sweep` --out directory: the cases it holds, and its
+// results.json when it has one (a sweep's, or an interrupted run's, has none).
+struct RunDirectory {
+    fs::path dir;
+    std::optional<nlohmann::json> results;
+    std::vector<std::string> case_names;
+};
 
-std::vector<std::string> run_case_names(const nlohmann::json& results) {
-    std::vector<std::string> names;
-    for (const nlohmann::json& one : results["cases"]) {
-        if (one.is_object() && one.contains("name") && one["name"].is_string()) names.push_back(one["name"]);
+RunDirectory run_directory(const fs::path& dir) {
+    RunDirectory run{dir, std::nullopt, {}};
+    const fs::path file = dir / "results.json";
+    if (fs::exists(file)) {
+        std::ifstream in(file);
+        nlohmann::json results = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+        if (results.is_discarded() || !results.is_object() || !results.contains("cases") || !results["cases"].is_array()) {
+            throw std::runtime_error(file.string() + ": not a results.json of rig run (no cases list)");
+        }
+        for (const nlohmann::json& one : results["cases"]) {
+            if (one.is_object() && one.contains("name") && one["name"].is_string()) run.case_names.push_back(one["name"]);
+        }
+        run.results = std::move(results);
+        return run;
     }
-    return names;
+    if (!fs::is_directory(dir / "cases")) {
+        throw std::runtime_error(dir.string() + ": neither a case's directory (trace.sqlite) nor a rig run or sweep "
+                                 "--out directory (results.json, cases/)");
+    }
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir / "cases")) {
+        if (fs::is_regular_file(entry.path() / "trace.sqlite")) run.case_names.push_back(entry.path().filename().string());
+    }
+    std::sort(run.case_names.begin(), run.case_names.end());
+    return run;
 }
 
 std::string listed(const std::vector<std::string>& names) {
@@ -67,23 +82,37 @@ std::string listed(const std::vector<std::string>& names) {
     return text.empty() ? "none" : text;
 }
 
-// The case `name` of a run directory: its trace and its results.json entry.
-Side side_of_run(const std::string& label, const fs::path& dir, const nlohmann::json& results, const std::string& name) {
+// The case `name` of a run directory: its trace, and its results.json entry
+// and rig when there is one.
+Side side_of_run(const std::string& label, const RunDirectory& run, const std::string& name) {
+    if (std::find(run.case_names.begin(), run.case_names.end(), name) == run.case_names.end()) {
+        throw std::runtime_error(run.dir.string() + ": no case " + name + " in it (its cases: " + listed(run.case_names) +
+                                 ")");
+    }
+    Side side;
+    side.label = label;
+    side.origin = run.dir.string() + ", case " + name;
+    side.trace_file = run.dir / "cases" / name / "trace.sqlite";
+    if (!run.results) return side;
+    const nlohmann::json& results = *run.results;
     for (const nlohmann::json& one : results["cases"]) {
         if (!one.is_object() || one.value("name", "") != name) continue;
-        Side side;
-        side.label = label;
-        side.origin = dir.string() + ", case " + name;
         const std::string relative = one.value("trace_path", "");
-        side.trace_file = relative.empty() ? dir / "cases" / name / "trace.sqlite" : dir / relative;
+        if (!relative.empty()) side.trace_file = run.dir / relative;
         side.recorded = one;
-        if (results.contains("rig") && results["rig"].is_object()) {
-            side.rig = results["rig"].value("version", "?") + " (commit " + results["rig"].value("commit", "?") + ")";
-        }
-        return side;
+        break;
     }
-    throw std::runtime_error(dir.string() + ": no case " + name + " in its results.json (its cases: " +
-                             listed(run_case_names(results)) + ")");
+    if (results.contains("rig") && results["rig"].is_object()) {
+        side.rig = results["rig"].value("version", "?") + " (commit " + results["rig"].value("commit", "?") + ")";
+    }
+    return side;
+}
+
+// A trace named directly: a file, or a case's directory holding trace.sqlite.
+std::optional<fs::path> trace_named_by(const fs::path& argument) {
+    if (!fs::is_directory(argument)) return argument;
+    if (fs::exists(argument / "trace.sqlite")) return argument / "trace.sqlite";
+    return std::nullopt;
 }
 
 // The two sides the command line names, their traces read. Throws
@@ -95,37 +124,36 @@ std::pair<Side, Side> sides_of(const std::vector<std::string>& inputs) {
     for (std::size_t i = 0; i < 2; ++i) {
         if (!fs::exists(inputs[i])) throw std::runtime_error(inputs[i] + ": no such file or directory");
     }
-    const bool a_dir = fs::is_directory(inputs[0]);
-    const bool b_dir = fs::is_directory(inputs[1]);
+    const std::optional<fs::path> a_trace = trace_named_by(inputs[0]);
+    const std::optional<fs::path> b_trace = trace_named_by(inputs[1]);
     std::pair<Side, Side> sides;
-    if (!a_dir && !b_dir) {
+    if (a_trace && b_trace) {
         if (inputs.size() == 3) {
-            throw std::runtime_error("a case name (" + inputs[2] + ") goes with two run directories, not trace files");
+            throw std::runtime_error("a case name (" + inputs[2] + ") goes with two run directories, not traces");
         }
-        sides.first = Side{"A", inputs[0], inputs[0], std::nullopt, "", {}};
-        sides.second = Side{"B", inputs[1], inputs[1], std::nullopt, "", {}};
-    } else if (a_dir && b_dir) {
-        const nlohmann::json a_results = results_of_run(inputs[0]);
-        const nlohmann::json b_results = results_of_run(inputs[1]);
+        sides.first = Side{"A", inputs[0], *a_trace, std::nullopt, "", {}};
+        sides.second = Side{"B", inputs[1], *b_trace, std::nullopt, "", {}};
+    } else if (!a_trace && !b_trace) {
+        const RunDirectory a_run = run_directory(inputs[0]);
+        const RunDirectory b_run = run_directory(inputs[1]);
         std::string name = inputs.size() == 3 ? inputs[2] : "";
         if (name.empty()) {
             // Without a name, a run of one case names it.
-            const std::vector<std::string> a_names = run_case_names(a_results);
-            const std::vector<std::string> b_names = run_case_names(b_results);
-            if (a_names.size() == 1) {
-                name = a_names.front();
-            } else if (b_names.size() == 1) {
-                name = b_names.front();
+            if (a_run.case_names.size() == 1) {
+                name = a_run.case_names.front();
+            } else if (b_run.case_names.size() == 1) {
+                name = b_run.case_names.front();
             } else {
-                throw std::runtime_error(inputs[0] + " holds the cases " + listed(a_names) +
+                throw std::runtime_error(inputs[0] + " holds the cases " + listed(a_run.case_names) +
                                          ": name the one to compare (rig diff A B CASE)");
             }
         }
-        sides.first = side_of_run("A", inputs[0], a_results, name);
-        sides.second = side_of_run("B", inputs[1], b_results, name);
+        sides.first = side_of_run("A", a_run, name);
+        sides.second = side_of_run("B", b_run, name);
     } else {
-        throw std::runtime_error((a_dir ? inputs[0] : inputs[1]) + " is a directory and " + (a_dir ? inputs[1] : inputs[0]) +
-                                 " is not: give two trace files, or two run directories and a case name");
+        throw std::runtime_error((a_trace ? inputs[1] : inputs[0]) + " is a run directory and " +
+                                 (a_trace ? inputs[0] : inputs[1]) +
+                                 " a trace: give two traces, or two run directories and a case name");
     }
     sides.first.trace = read_trace(sides.first.trace_file);
     sides.second.trace = read_trace(sides.second.trace_file);
