@@ -49,6 +49,7 @@ private:
     bool quiet_ = false;
     bool verbose_ = false;
     bool dds_security_ = false;
+    std::string bmf_file_;
 };
 
 class SweepCommand final : public Subcommand {
@@ -67,6 +68,7 @@ private:
     std::uint64_t first_seed_ = 1;
     std::string keep_traces_ = "failed";
     bool quiet_ = false;
+    std::string bmf_file_;
 };
 
 // The help text of --no-pin, shared with `rig bench`.
