@@ -46,6 +46,10 @@ struct BoundaryControllerFaults {
     // only, so nozzles inside spray while the boom centre is outside (the
     // headland double spray of spraying environment 2).
     bool ignore_centre_rule = false;
+    // A duty message that turns any nozzle on carries one entry more than the
+    // boom has nozzles (a fill loop that runs to <= nozzle_count): 7 duties
+    // for 6 nozzles, which the plant refuses (malformed_command).
+    bool extra_duty_entry = false;
 };
 
 struct BoundaryControllerConfig {

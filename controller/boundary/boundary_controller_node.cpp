@@ -227,6 +227,9 @@ TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
         msg::NozzlePwm pwm;
         pwm.frequency_hz(logic_.pwm_frequency_hz());
         pwm.duty_pct(duty);
+        // TEST-ONLY fault: a message that sprays has a duty for a nozzle the boom does not have.
+        const bool spraying = std::any_of(duty.begin(), duty.end(), [](double pct) { return pct > 0.0; });
+        if (logic_.config().faults.extra_duty_entry && spraying) pwm.duty_pct().push_back(duty.back());
         pwm_writer_->publish(pwm);
         published_duty_pct_ = duty;
         published_once_ = true;
