@@ -37,10 +37,16 @@ function(rig_generate_idl out_var)
     get_filename_component(stem ${idl} NAME_WE)
     set(outs ${gen_dir}/${stem}.h ${gen_dir}/${stem}.cxx
              ${gen_dir}/${stem}PubSubTypes.h ${gen_dir}/${stem}PubSubTypes.cxx)
+    # fastddsgen preprocesses the IDL into TEMP/NAME.idl.cc, TEMP being /tmp
+    # unless -t says otherwise: two builds on one machine (two checkouts, or
+    # the SDK install test's build beside another) then overwrite each other's
+    # file, and one of them silently generates no PubSubTypes (seen: the build
+    # failed on a missing actuatorPubSubTypes.cxx). Each IDL gets its own.
+    set(tmp_dir ${CMAKE_CURRENT_BINARY_DIR}/fastddsgen-tmp/${stem})
     add_custom_command(
       OUTPUT ${outs}
-      COMMAND ${CMAKE_COMMAND} -E make_directory ${gen_dir}
-      COMMAND ${FASTDDSGEN} -replace -d ${gen_dir} ${CMAKE_CURRENT_SOURCE_DIR}/${idl}
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${gen_dir} ${tmp_dir}
+      COMMAND ${FASTDDSGEN} -replace -t ${tmp_dir} -d ${gen_dir} ${CMAKE_CURRENT_SOURCE_DIR}/${idl}
       DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${idl}
       COMMENT "fastddsgen ${idl}"
       VERBATIM)

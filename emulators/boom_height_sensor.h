@@ -10,13 +10,9 @@
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
 #include "rig/papers/seed000.h"
+#include "emulators/boom_height_sensor_params.h"
 
 namespace rig::emulators {
-
-struct BoomHeightSensorParams {
-    double range_m = papers::seed000::kBoomHeightRangeM;  // h at 3.3 V
-    double rate_hz = 10.0;
-};
 
 class BoomHeightSensor final : public Node {
 public:

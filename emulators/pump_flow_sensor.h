@@ -17,16 +17,9 @@
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
 #include "rig/papers/seed000.h"
+#include "emulators/pump_flow_sensor_params.h"
 
 namespace rig::emulators {
-
-struct PumpFlowSensorParams {
-    double full_scale_m3_h = papers::seed000::kPumpSensorFullScaleM3H;   // Q_F of Eq. 8 (133 L/min)
-    double noise_mv = 2.0;
-    double offset_ma = 0.0;
-    double rate_hz = 20.0;
-    std::uint64_t seed = 1;
-};
 
 class PumpFlowSensor final : public Node {
 public:

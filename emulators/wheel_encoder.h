@@ -20,14 +20,9 @@
 
 #include "emulators/plant.h"
 #include "rig/papers/seed000.h"
+#include "emulators/wheel_encoder_params.h"
 
 namespace rig::emulators {
-
-struct WheelEncoderParams {
-    std::uint32_t pulses_per_rev = papers::seed000::kEncoderPulsesPerRev;
-    double wheel_diameter_m = papers::seed000::kLandWheelDiameterM;
-    double rate_hz = 100.0;
-};
 
 class WheelEncoder final : public Node {
 public:

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "controller/boundary/boundary_node_config.h"
 #include "harness/spec/case_spec.h"
@@ -114,6 +115,74 @@ TEST(BoundaryCase, TheJobCarriesTheAreaAndTheCamerasToTheController) {
     EXPECT_FALSE(rig::controller::boundary::parse_boundary_node_config(
                      rig::YamlSection::load_string("vision: { enabled: false }", "controller.yaml"), with_cameras)
                      .vision.enabled);
+}
+
+// The job also carries the field's origin and the sprayer as the case builds
+// it (docs/controller-contract.md "The job"): a case with its own four nozzles,
+// lift, laser mounting and PWM frequency reaches the controller whole, and the
+// reference controller takes it where its own section is silent.
+TEST(BoundaryCase, TheJobCarriesTheFieldAndTheSprayerAsTheCaseHasThem) {
+    const std::string text =
+        edited("judge:\n",
+               "spray:\n"
+               "  flow_table:\n"
+               "    - { points: [ { duty_pct: 30, flow_ml_min: 420 }, { duty_pct: 100, flow_ml_min: 650 } ] }\n"
+               "    - { points: [ { duty_pct: 30, flow_ml_min: 420 }, { duty_pct: 100, flow_ml_min: 650 } ] }\n"
+               "    - { points: [ { duty_pct: 30, flow_ml_min: 420 }, { duty_pct: 100, flow_ml_min: 650 } ] }\n"
+               "    - { points: [ { duty_pct: 30, flow_ml_min: 420 }, { duty_pct: 100, flow_ml_min: 650 } ] }\n"
+               "sprayer:\n"
+               "  nozzle_count: 4\n"
+               "  nozzle_spacing_m: 0.35\n"
+               "  lift: { rod_length_m: 0.6, hinge_height_m: 0.85, antenna_to_o_m: 0.25, hinge_to_boom_centre_m: 1.1 }\n"
+               "laser: { mount_offset_m: 0.07 }\n"
+               "valves: { frequency_hz: 12.5 }\n"
+               "judge:\n");
+    const CaseSpec spec = parse_case(text, "own-sprayer.yaml");
+    const BoundarySections& b = boundary_sections(spec);
+    const fs::path dir = rig::testing::fresh_dir("boundary-job-sprayer");
+    system_of(spec).plan_run(spec, 1)->write_controller_inputs(dir);
+    const rig::controller::boundary::BoundaryJob job = rig::controller::boundary::load_boundary_job(dir / "job.yaml");
+    // Exactly the case's doubles (shortest round-trip text).
+    EXPECT_EQ(job.field_origin.lat_deg, b.origin.lat_deg);
+    EXPECT_EQ(job.field_origin.lon_deg, b.origin.lon_deg);
+    EXPECT_EQ(job.field_origin_height_m, b.origin.height_m);
+    // The sprayer: nozzles, Eq. 18's I, Hp, M, L, the laser's mounting, the PWM
+    // frequency (the job's and the reference configuration's names are the same).
+    const auto sprayer_of = [](const auto& s) {
+        return std::vector<double>{static_cast<double>(s.nozzle_count), s.nozzle_spacing_m, s.lift_rod_length_m,
+                                   s.lift_hinge_height_m, s.antenna_to_o_m, s.hinge_to_boom_centre_m,
+                                   s.laser_mount_offset_m, s.pwm_frequency_hz};
+    };
+    const std::vector<double> case_sprayer{4, 0.35, 0.6, 0.85, 0.25, 1.1, 0.07, 12.5};
+    EXPECT_EQ(sprayer_of(job), case_sprayer);
+
+    const auto config = [&](const std::string& section) {
+        return rig::controller::boundary::parse_boundary_node_config(
+                   rig::YamlSection::load_string(section, "controller.yaml"), job)
+            .controller;
+    };
+    // The reference controller's own keys of the same meaning take the job's.
+    EXPECT_EQ(sprayer_of(config("{}")), case_sprayer);
+    // The controller's own section wins (a wrong belief is the case's to give).
+    const rig::controller::boundary::BoundaryControllerConfig own = config("nozzle_spacing_m: 0.5\npwm_frequency_hz: 9\n");
+    EXPECT_EQ(own.nozzle_spacing_m, 0.5);
+    EXPECT_EQ(own.pwm_frequency_hz, 9.0);
+    EXPECT_EQ(own.nozzle_count, 4);
+
+    // A job without the sprayer is refused at its key, naming the file.
+    std::string broken = rig::testing::read_all(dir / "job.yaml");
+    const std::size_t at = broken.find("nozzle_spacing_m:");
+    ASSERT_NE(at, std::string::npos) << broken;
+    broken.replace(at, std::string("nozzle_spacing_m").size(), "nozzle_pitch_m");
+    std::ofstream(dir / "broken-job.yaml") << broken;
+    try {
+        rig::controller::boundary::load_boundary_job(dir / "broken-job.yaml");
+        ADD_FAILURE() << "a job without sprayer.nozzle_spacing_m was accepted";
+    } catch (const rig::ConfigError& error) {
+        const std::string message = error.what();
+        EXPECT_NE(message.find("broken-job.yaml:"), std::string::npos) << message;
+        EXPECT_NE(message.find("nozzle_pitch_m"), std::string::npos) << message;
+    }
 }
 
 TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {

@@ -1,22 +1,29 @@
 // Seed 001's reference controller logic, positioning and boundary half
 // (controller/boundary/): UTM zone, Eq. 14 levels, Eq. 18 and 19, the two
 // shut-off rules of Sec. 4.2 on drives across an area's edge, the look-ahead
-// option, and hostile input. RMC sentences are written with the emulators'
+// option, hostile input, and the node's duty commands (DutyCommandDelay, with
+// the TEST-ONLY late fault). RMC sentences are written with the emulators'
 // encoder from positions in the field's local frame (the plant's truth), so the
 // controller's UTM and grid-convergence handling are exercised for real.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "controller/boundary/boundary_controller.h"
 #include "controller/boundary/boundary_equations.h"
+#include "controller/boundary/duty_command_delay.h"
 #include "controller/boundary/utm_area.h"
 #include "emulators/field2d/local_frame.h"
 #include "emulators/field2d/vec2.h"
 #include "rig/nmea/nmea_encoder.h"
+#include "rig/text/number_text.h"
 
 namespace {
 
@@ -123,6 +130,79 @@ TEST(BoundaryEquations, Eq18AndEq19) {
     const GridPoint east = eq19_body_to_grid({100.0, 200.0}, 90.0, 1.25, 1.0);
     EXPECT_DOUBLE_EQ(east.x_m, 101.0);
     EXPECT_DOUBLE_EQ(east.y_m, 198.75);
+}
+
+// The rows of the markdown table in `doc` whose header row starts with `header`:
+// each row's cells, trimmed. Fails the test when the table is not there.
+std::vector<std::vector<std::string>> doc_table(const std::string& doc, const std::string& header) {
+    std::vector<std::vector<std::string>> rows;
+    const std::size_t start = doc.find(header);
+    EXPECT_NE(start, std::string::npos) << "no table headed '" << header << "'";
+    if (start == std::string::npos) return rows;
+    std::istringstream lines(doc.substr(start));
+    std::string line;
+    std::getline(lines, line);  // the header
+    std::getline(lines, line);  // | --- | ... |
+    while (std::getline(lines, line) && line.rfind("| ", 0) == 0) {
+        std::vector<std::string> cells;
+        std::istringstream cell_stream(line.substr(1));
+        for (std::string cell; std::getline(cell_stream, cell, '|');) {
+            const std::size_t first = cell.find_first_not_of(' ');
+            const std::size_t last = cell.find_last_not_of(' ');
+            cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
+        }
+        rows.push_back(cells);
+    }
+    return rows;
+}
+
+std::string point_text(const GridPoint& p) {
+    return "(" + rig::fixed_text(p.x_m, 4) + ", " + rig::fixed_text(p.y_m, 4) + ")";
+}
+
+// docs/seed001-boundary.md "Writing a seed-001 controller" works Eq. 18-19 and
+// Eq. 12-14 through for a team writing its own controller: every number there
+// is what the reference controller's equations give, at the printed precision.
+TEST(BoundaryEquations, TheWorkedExamplesInTheDocsAreTheCodes) {
+    std::ifstream file(RIG_SOURCE_DIR "/docs/seed001-boundary.md");
+    ASSERT_TRUE(file) << "docs/seed001-boundary.md";
+    const std::string doc((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const BoundaryControllerConfig c = square_config();
+
+    const auto positions = doc_table(doc, "| H (m) | Y1 (m) | nozzle 0, b = 0 |");
+    ASSERT_GE(positions.size(), 3u);  // more than one boom height
+    for (const std::vector<std::string>& row : positions) {
+        ASSERT_EQ(row.size(), 6u) << row.front();
+        const double height_m = std::stod(row[0]);
+        const double y1_m = eq18_boom_offset_m(c, height_m);
+        EXPECT_EQ(row[1], rig::fixed_text(y1_m, 4)) << "Y1 at H = " << row[0];
+        std::size_t column = 2;
+        for (const double course_deg : {0.0, 30.0}) {
+            for (const double right_m : {-1.25, 1.25}) {  // nozzles 0 and 5 of six 0.5 m apart
+                EXPECT_EQ(row[column++], point_text(eq19_body_to_grid({0.0, 0.0}, course_deg, right_m, y1_m)))
+                    << "H = " << row[0] << ", course " << course_deg << ", x = " << right_m;
+            }
+        }
+    }
+
+    const auto rates = doc_table(doc, "| D | v (m/s) | q (L/min) |");
+    ASSERT_GE(rates.size(), 4u);
+    std::set<int> levels;
+    for (const std::vector<std::string>& row : rates) {
+        ASSERT_EQ(row.size(), 6u) << row.front();
+        const double density = std::stod(row[0]);
+        const double speed_m_s = std::stod(row[1]);
+        const double flow_l_min = c.eq12_coefficient_l_min_per_m_s * density * speed_m_s / c.k_max_cover;
+        const double duty_pct = eq14_theoretical_duty_pct(c, density, speed_m_s);
+        const int level = spray_level(c, duty_pct);
+        levels.insert(level);
+        const std::string where = "D = " + row[0] + ", v = " + row[1];
+        EXPECT_EQ(row[2], rig::fixed_text(flow_l_min, 4)) << where;
+        EXPECT_EQ(row[3], rig::fixed_text(duty_pct, 2)) << where;
+        EXPECT_EQ(row[4], std::to_string(level)) << where;
+        EXPECT_EQ(row[5], rig::shortest_text(level_duty_pct(c, level)) + " %") << where;
+    }
+    EXPECT_EQ(levels, (std::set<int>{0, 1, 2})) << "the table shows every level";
 }
 
 TEST(BoundaryController, Rule1ANozzleOutsideTheAreaIsOff) {
@@ -360,6 +440,41 @@ TEST(BoundaryController, BadConfigurationIsRejectedByName) {
     c = square_config();
     c.default_boom_height_m = 2.0;
     expect_bad(c, "default_boom_height_m");
+    c = square_config();
+    c.faults.command_delay_s = -0.1;
+    expect_bad(c, "faults.command_delay_s");
+}
+
+TEST(DutyCommandDelay, WithoutDelayEachChangeGoesOutInTheStepThatDecidedIt) {
+    DutyCommandDelay commands(0);
+    const std::vector<double> open(6, 100.0);
+    const std::vector<double> shut(6, 0.0);
+    commands.decide(shut, 0);  // the first command goes out, whatever it says
+    EXPECT_EQ(commands.take_due(0), std::vector<std::vector<double>>{shut});
+    commands.decide(shut, seconds_to_ns(0.1));  // unchanged: nothing to send
+    EXPECT_TRUE(commands.take_due(seconds_to_ns(0.1)).empty());
+    EXPECT_EQ(commands.next_due_ns(), rig::kNever);
+    commands.decide(open, seconds_to_ns(0.2));
+    EXPECT_EQ(commands.take_due(seconds_to_ns(0.2)), std::vector<std::vector<double>>{open});
+}
+
+TEST(DutyCommandDelay, TheLateFaultSendsEveryChangeInOrderTheDelayAfterItsDecision) {
+    // 0.3 s late: the changes decided at 1.0 and 1.1 s go out at 1.3 and 1.4 s,
+    // both, in order, though the second was decided before the first went out.
+    DutyCommandDelay commands(seconds_to_ns(0.3));
+    const std::vector<double> open(6, 100.0);
+    const std::vector<double> half{100, 100, 100, 0, 0, 0};
+    const std::vector<double> shut(6, 0.0);
+    commands.decide(open, seconds_to_ns(0.5));
+    commands.decide(half, seconds_to_ns(1.0));
+    commands.decide(shut, seconds_to_ns(1.1));
+    EXPECT_EQ(commands.next_due_ns(), seconds_to_ns(0.8));
+    EXPECT_TRUE(commands.take_due(seconds_to_ns(0.8) - 1).empty());
+    EXPECT_EQ(commands.take_due(seconds_to_ns(1.2)), std::vector<std::vector<double>>{open});
+    EXPECT_EQ(commands.next_due_ns(), seconds_to_ns(1.3));
+    EXPECT_EQ(commands.take_due(seconds_to_ns(1.4)), (std::vector<std::vector<double>>{half, shut}));
+    EXPECT_EQ(commands.next_due_ns(), rig::kNever);
+    EXPECT_THROW(DutyCommandDelay(-1), std::invalid_argument);
 }
 
 }  // namespace

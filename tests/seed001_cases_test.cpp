@@ -77,11 +77,12 @@ TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
     EXPECT_EQ(along.at("metrics").at("boundary_overrun_stations_dry").get<double>(), 11.0);
 
     // Without the rule the inside nozzles spray on after the centre has left,
-    // metres past the crossing: caught on centre_out_close_m.
+    // until nozzle 0 (1.25 m left of it, crossing at 60 deg) is out itself,
+    // 1.25 cot 60 deg = 0.72 m on: caught on centre_out_close_m.
     const nlohmann::json& centre = find_case(results, "seed001-faulty-ignore-centre-rule");
     EXPECT_TRUE(centre.at("expected_failure").get<bool>()) << centre.dump(2);
     EXPECT_EQ(failing_metrics(centre), std::set<std::string>{"centre_out_close_m"});
-    EXPECT_GT(centre.at("metrics").at("centre_out_close_m").get<double>(), 2.0);
+    EXPECT_GT(centre.at("metrics").at("centre_out_close_m").get<double>(), 0.72);
 
     // Every metric and verdict again from the traces alone.
     EXPECT_EQ(rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",
@@ -155,6 +156,50 @@ TEST(Seed001Cases, ADutyMessageWithAnExtraEntryFailsTheCaseNamingTopicInstantAnd
     EXPECT_NE(rig::testing::read_all(out / "judge.log").find("re-judged: every metric, verdict and digest as recorded"),
               std::string::npos)
         << rig::testing::read_all(out / "judge.log");
+}
+
+// The boom centre crossing out of the area at 60 deg, each case on its own ten
+// seeds: the reference controller closes within the loop's delay budget on
+// every one, and a controller acting 0.3 s late or believing the boom centre
+// 1 m nearer the antenna fails on centre_out_close_m alone on every one.
+TEST(Seed001Cases, TheCentreCrossingCatchesALateOrMisplacedCentreOnEverySeed) {
+    const fs::path out = fresh_dir("centre-crossing");
+    const std::string files =
+        "'" + (kCases / "seed001-table8-boundary" / "centre-crosses-out.yaml").string() + "' '" +
+        (kCases / "seed001-faulty-controllers" / "late-at-centre-crossing.yaml").string() + "' '" +
+        (kCases / "seed001-faulty-controllers" / "wrong-antenna-offset-centre-crossing.yaml").string() + "'";
+    const int status = rig("run " + files + " --jobs 2 --out '" + (out / "run").string() + "'", out / "run.log");
+    ASSERT_EQ(status, 0) << rig::testing::read_all(out / "run.log");
+    const nlohmann::json results = load_results(out / "run");
+    constexpr double kSpeedMS = 1.5;
+    constexpr double kPwmPeriodS = 1.0 / 9.0;
+    constexpr double kJudgeStepM = kSpeedMS * 0.005;
+    for (int seed = 1; seed <= 10; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const std::string suffix = "-seed" + std::to_string(seed);
+        const nlohmann::json& reference = find_case(results, "seed001-table8-centre-crosses-out" + suffix);
+        EXPECT_TRUE(reference.at("passed").get<bool>()) << reference.dump(2);
+        EXPECT_EQ(reference.at("metrics").at("centre_out_crossings").get<double>(), 1.0);
+        const double reference_m = reference.at("metrics").at("centre_out_close_m").get<double>();
+        // At least RMC latency + stroke after the crossing (the UTM error's
+        // 1.2 cm early is 0.009 s of it): the rule acts after the truth crossing.
+        EXPECT_GT(reference_m, 0.0);
+
+        const nlohmann::json& late = find_case(results, "seed001-faulty-late-at-centre-crossing" + suffix);
+        EXPECT_TRUE(late.at("expected_failure").get<bool>()) << late.dump(2);
+        EXPECT_EQ(failing_metrics(late), std::set<std::string>{"centre_out_close_m"});
+        // The same seed gives the same fixes, so the same decision: 0.3 s
+        // later, give or take where the PWM latch falls (one period).
+        const double late_m = late.at("metrics").at("centre_out_close_m").get<double>();
+        EXPECT_GE(late_m - reference_m, kSpeedMS * (0.3 - kPwmPeriodS) - kJudgeStepM);
+        EXPECT_LE(late_m - reference_m, kSpeedMS * (0.3 + kPwmPeriodS) + kJudgeStepM);
+
+        const nlohmann::json& offset = find_case(results, "seed001-faulty-wrong-antenna-offset-centre-crossing" + suffix);
+        EXPECT_TRUE(offset.at("expected_failure").get<bool>()) << offset.dump(2);
+        EXPECT_EQ(failing_metrics(offset), std::set<std::string>{"centre_out_close_m"});
+        // The centre it believes trails the true one by 1 m of travel.
+        EXPECT_GT(offset.at("metrics").at("centre_out_close_m").get<double>(), 1.0);
+    }
 }
 
 TEST(Seed001Cases, SameSeedSameTraceAnotherSeedAnotherTrace) {

@@ -74,6 +74,7 @@ void validate_settings(const BoundaryControllerConfig& c) {
     in_range("course_hold_speed_m_s", c.course_hold_speed_m_s, 0.0, 5.0);
     in_range("fix_timeout_s", c.fix_timeout_s, 0.0, 10.0, true);
     in_range("faults.antenna_offset_error_m", c.faults.antenna_offset_error_m, -5.0, 5.0);
+    in_range("faults.command_delay_s", c.faults.command_delay_s, 0.0, 2.0);
 }
 
 }  // namespace rig::controller::boundary

@@ -50,6 +50,10 @@ struct BoundaryControllerFaults {
     // boom has nozzles (a fill loop that runs to <= nozzle_count): 7 duties
     // for 6 nozzles, which the plant refuses (malformed_command).
     bool extra_duty_entry = false;
+    // Every duty command goes out this long after the logic decided it (case
+    // time): a controller that acts late, e.g. an output task fed through a
+    // queue (controller/boundary/duty_command_delay.h). [0, 2] s.
+    double command_delay_s = 0.0;
 };
 
 struct BoundaryControllerConfig {

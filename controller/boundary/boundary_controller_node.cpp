@@ -15,6 +15,7 @@ BoundaryControllerNode::BoundaryControllerNode(std::string node_name, BoundaryNo
       serial_(std::move(serial)),
       sweep_(std::move(config.calibration)),
       logic_(config.controller),
+      commands_(seconds_to_ns(config.controller.faults.command_delay_s)),
       vision_config_(config.vision) {
     if (vision_config_.enabled) {
         std::size_t index = 0;
@@ -223,17 +224,17 @@ TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
         next_wake = next_change;
     }
     for (const std::string& notice : logic_.take_notices()) std::cerr << name_ << ": " << notice << "\n";
-    if (!published_once_ || duty != published_duty_pct_) {
+    commands_.decide(duty, now_ns);
+    for (std::vector<double>& due : commands_.take_due(now_ns)) {
         msg::NozzlePwm pwm;
         pwm.frequency_hz(logic_.pwm_frequency_hz());
-        pwm.duty_pct(duty);
         // TEST-ONLY fault: a message that sprays has a duty for a nozzle the boom does not have.
-        const bool spraying = std::any_of(duty.begin(), duty.end(), [](double pct) { return pct > 0.0; });
-        if (logic_.config().faults.extra_duty_entry && spraying) pwm.duty_pct().push_back(duty.back());
+        const bool spraying = std::any_of(due.begin(), due.end(), [](double pct) { return pct > 0.0; });
+        if (logic_.config().faults.extra_duty_entry && spraying) due.push_back(due.back());
+        pwm.duty_pct(std::move(due));
         pwm_writer_->publish(pwm);
-        published_duty_pct_ = duty;
-        published_once_ = true;
     }
+    next_wake = std::min(next_wake, commands_.next_due_ns());
     // A port does not wake the node when a line arrives: it is polled.
     if (nmea_port_ || laser_port_) next_wake = std::min(next_wake, now_ns + serial_.poll_period_ns);
     return next_wake;

@@ -21,6 +21,7 @@
 
 #include "controller/boundary/boundary_controller.h"
 #include "controller/boundary/boundary_node_config.h"
+#include "controller/boundary/duty_command_delay.h"
 #include "controller/boundary/vision/nozzle_vision.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
@@ -71,6 +72,7 @@ private:
     std::unique_ptr<SerialPort> laser_port_;
     DutySweepConfig sweep_;
     BoundaryController logic_;
+    DutyCommandDelay commands_;  // what goes out on actuator/nozzle_pwm/duty, and when
     std::unique_ptr<Reader<msg::NmeaSentence>> nmea_reader_;
     std::unique_ptr<Reader<msg::SerialLine>> laser_reader_;
     std::unique_ptr<Writer<msg::NozzlePwm>> pwm_writer_;
@@ -81,8 +83,6 @@ private:
     std::vector<TimeNs> density_time_ns_;
     std::vector<bool> calibrated_;            // per camera: nozzle points found in a calibration frame
     std::vector<bool> calibration_noticed_;   // per camera: a refused calibration frame was told  // per nozzle, when its density was measured (-1: none)
-    std::vector<double> published_duty_pct_;
-    bool published_once_ = false;
 };
 
 }  // namespace rig::controller::boundary

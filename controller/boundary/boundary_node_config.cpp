@@ -34,6 +34,17 @@ BoundaryNodeConfig parse_section(const YamlSection& section, const std::optional
     section.allow("command");  // the rig's key (kControllerRigKeys)
     for (const YamlSection& area : section.list("areas")) c.areas.push_back(read_area(area));
     if (c.areas.empty() && job) c.areas = job->areas;
+    // The sprayer as the job gives it, unless the section says otherwise (read below).
+    if (job) {
+        c.nozzle_count = job->nozzle_count;
+        c.nozzle_spacing_m = job->nozzle_spacing_m;
+        c.lift_rod_length_m = job->lift_rod_length_m;
+        c.lift_hinge_height_m = job->lift_hinge_height_m;
+        c.antenna_to_o_m = job->antenna_to_o_m;
+        c.hinge_to_boom_centre_m = job->hinge_to_boom_centre_m;
+        c.laser_mount_offset_m = job->laser_mount_offset_m;
+        c.pwm_frequency_hz = job->pwm_frequency_hz;
+    }
     c.nozzle_count = section.optional_in_range<int>("nozzle_count", c.nozzle_count, Bounds::closed(1, 32));
     read_double(section, "nozzle_spacing_m", c.nozzle_spacing_m);
     read_double(section, "lift_rod_length_m", c.lift_rod_length_m);
@@ -66,6 +77,7 @@ BoundaryNodeConfig parse_section(const YamlSection& section, const std::optional
     c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
     c.faults.ignore_centre_rule = faults.optional<bool>("ignore_centre_rule", false);
     c.faults.extra_duty_entry = faults.optional<bool>("extra_duty_entry", false);
+    read_double(faults, "command_delay_s", c.faults.command_delay_s);
 
     // The cameras on the boom are used unless the section says how (or not).
     const bool vision_from_job = job && job->cameras && !section.has("vision");
@@ -140,8 +152,24 @@ BoundaryNodeConfig load_boundary_node_config(const std::filesystem::path& file,
 BoundaryJob load_boundary_job(const std::filesystem::path& file) {
     const YamlSection root = YamlSection::load_file(file);
     BoundaryJob job;
+    const YamlSection origin = root.required_section("field").required_section("origin");
+    job.field_origin = GeoCorner{origin.required_in_range<double>("lat_deg", Bounds::closed(-80, 84)),
+                                 origin.required_in_range<double>("lon_deg", Bounds::closed(-180, 180))};
+    job.field_origin_height_m = origin.required_in_range<double>("height_m", Bounds::closed(-1000, 10000));
     for (const YamlSection& area : root.list("areas")) job.areas.push_back(read_area(area));
     if (job.areas.empty()) root.fail("areas", "a job names at least one target area");
+    // Bounds as the reference's own keys have them (validate() holds the
+    // configuration they go into to the same ones).
+    const YamlSection sprayer = root.required_section("sprayer");
+    job.nozzle_count = sprayer.required_in_range<int>("nozzle_count", Bounds::closed(1, 32));
+    job.nozzle_spacing_m = sprayer.required_in_range<double>("nozzle_spacing_m", kFinite);
+    const YamlSection lift = sprayer.required_section("lift");
+    job.lift_rod_length_m = lift.required_in_range<double>("rod_length_m", kFinite);
+    job.lift_hinge_height_m = lift.required_in_range<double>("hinge_height_m", kFinite);
+    job.antenna_to_o_m = lift.required_in_range<double>("antenna_to_o_m", kFinite);
+    job.hinge_to_boom_centre_m = lift.required_in_range<double>("hinge_to_boom_centre_m", kFinite);
+    job.laser_mount_offset_m = root.required_section("laser").required_in_range<double>("mount_offset_m", kFinite);
+    job.pwm_frequency_hz = root.required_section("valves").required_in_range<double>("frequency_hz", kFinite);
     if (root.has("cameras")) {
         const YamlSection cameras = root.section("cameras");
         job.cameras = true;

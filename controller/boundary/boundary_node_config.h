@@ -8,11 +8,13 @@
 // sections.
 //
 // Beside it the rig gives a seed-001 controller the job (--job FILE,
-// docs/controller-contract.md "The job"): the target areas the operator
-// recorded before work (Sec. 4.2.2) and the cameras on the boom. The job's
-// areas are the controller's when its section names none; with cameras on the
-// boom and no `vision` section, it measures the cover with them (and
-// calibrates from the boards while the job says the scene shows them).
+// docs/controller-contract.md "The job"): the field, the target areas the
+// operator recorded before work (Sec. 4.2.2), the sprayer (nozzles, Eq. 18's
+// lift, the laser's mounting, the PWM frequency) and the cameras on the boom.
+// The job's areas and sprayer are the controller's where its section does not
+// say otherwise; with cameras on the boom and no `vision` section, it measures
+// the cover with them (and calibrates from the boards while the job says the
+// scene shows them).
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -61,9 +63,23 @@ struct BoundaryNodeConfig {
     VisionNodeConfig vision;
 };
 
-// The job file (job.yaml), as the rig writes it.
+// The job file (job.yaml), as the rig writes it (docs/controller-contract.md
+// "The job": every key with its frame and unit).
 struct BoundaryJob {
+    GeoCorner field_origin;               // the case's local east-north frame (the reference projects to UTM instead)
+    double field_origin_height_m = 0.0;   // above the WGS84 ellipsoid
     std::vector<TargetAreaConfig> areas;  // at least one
+    // The sprayer as it stands (the case's `sprayer:`, `laser:` and `valves:`):
+    // the reference controller's own keys of the same meaning, unless its
+    // section sets them.
+    int nozzle_count = papers::seed001::kNozzleCount;
+    double nozzle_spacing_m = papers::seed001::kNozzleSpacingM;
+    double lift_rod_length_m = papers::seed001::kLiftRodLengthM;                 // I
+    double lift_hinge_height_m = papers::seed001::kLiftHingeHeightM;             // Hp
+    double antenna_to_o_m = papers::seed001::kLiftAntennaToOM;                   // M
+    double hinge_to_boom_centre_m = papers::seed001::kLiftHingeToBoomCentreM;    // L
+    double laser_mount_offset_m = 0.0;    // the laser reads D = H + this
+    double pwm_frequency_hz = papers::seed001::kPwmFrequencyHz;
     bool cameras = false;  // the two boom cameras publish frames, on these topics:
     std::string left_camera_topic;
     std::string right_camera_topic;

@@ -11,6 +11,7 @@
 #include "harness/systems/boundary/boundary_world.h"
 #include "harness/trace/trace_recorder.h"
 #include "idl/topics.h"
+#include "rig/text/number_text.h"
 #include "rig/wire/wire_adapters.h"
 
 namespace rig::harness {
@@ -86,32 +87,62 @@ private:
     std::vector<Node*> all_;
 };
 
+// A number in the job as the shortest text that reads back as the same
+// double: the controller's values are the case's, bit for bit.
+YAML::Node number(double value) { return YAML::Node(shortest_text(value)); }
+
 // The job as the operator set it up before work (Sec. 4.2.2: the area's
-// corners recorded with the receiver), and the cameras on the boom: what a
-// seed-001 controller is given besides its configuration.
+// corners recorded with the receiver), and the machine as it stands: what a
+// seed-001 controller is given besides its configuration. `field`, `sprayer`,
+// `laser` and `valves` hold the case file's keys of the same names, `areas`
+// its `area` (docs/controller-contract.md "The job" gives each key with its
+// frame and unit); the route, the boom-height profile and the devices' noise
+// stay the plant's, as they would in a field.
 std::string job_yaml(const BoundarySections& own) {
     YAML::Node job;
+    YAML::Node origin;
+    origin["lat_deg"] = number(own.origin.lat_deg);
+    origin["lon_deg"] = number(own.origin.lon_deg);
+    origin["height_m"] = number(own.origin.height_m);
+    job["field"]["origin"] = origin;
     YAML::Node area;
     area["name"] = own.area_name;
-    area["density"] = own.area_density;
+    area["density"] = number(own.area_density);
     for (const field2d::GeodeticPoint& corner : own.corners) {
         YAML::Node c;
-        c["lat_deg"] = corner.lat_deg;
-        c["lon_deg"] = corner.lon_deg;
+        c["lat_deg"] = number(corner.lat_deg);
+        c["lon_deg"] = number(corner.lon_deg);
         area["corners"].push_back(c);
     }
     job["areas"].push_back(area);
+    // The boom relative to the antenna: nozzles across it, Eq. 18's lift along.
+    YAML::Node lift;
+    lift["rod_length_m"] = number(own.mounting.lift.rod_length_m);
+    lift["hinge_height_m"] = number(own.mounting.lift.hinge_height_m);
+    lift["antenna_to_o_m"] = number(own.mounting.lift.antenna_to_o_m);
+    lift["hinge_to_boom_centre_m"] = number(own.mounting.lift.hinge_to_boom_centre_m);
+    YAML::Node sprayer;
+    sprayer["nozzle_count"] = own.mounting.nozzle_count;
+    sprayer["nozzle_spacing_m"] = number(own.mounting.nozzle_spacing_m);
+    sprayer["lift"] = lift;
+    job["sprayer"] = sprayer;
+    YAML::Node laser;
+    laser["mount_offset_m"] = number(own.laser.mount_offset_m);
+    job["laser"] = laser;
+    YAML::Node valves;
+    valves["frequency_hz"] = number(own.valves.frequency_hz);
+    job["valves"] = valves;
     if (own.vision) {
         job["cameras"]["left"] = topics::kCameraLeftFrame;
         job["cameras"]["right"] = topics::kCameraRightFrame;
         if (own.vision->calibration_until_s > 0.0) {
-            job["cameras"]["calibration_scene_until_s"] = own.vision->calibration_until_s;
+            job["cameras"]["calibration_scene_until_s"] = number(own.vision->calibration_until_s);
         }
     }
     YAML::Emitter out;
     out << job;
-    return std::string("# The job of this run (docs/controller-contract.md \"The job\"): the target areas\n"
-                       "# the operator recorded before work and the cameras on the boom.\n") +
+    return std::string("# The job of this run (docs/controller-contract.md \"The job\"): the field, the target\n"
+                       "# areas the operator recorded before work, the sprayer and the cameras on the boom.\n") +
            out.c_str() + "\n";
 }
 

@@ -20,14 +20,14 @@
 #include <string_view>
 #include <vector>
 
-#include "emulators/boom_height_sensor.h"
-#include "emulators/flow_meter_kf11.h"
-#include "emulators/gnss_g970.h"
+#include "emulators/boom_height_sensor_params.h"
+#include "emulators/flow_meter_kf11_params.h"
+#include "emulators/gnss_g970_params.h"
 #include "emulators/land_wheel.h"
-#include "emulators/pump_flow_sensor.h"
+#include "emulators/pump_flow_sensor_params.h"
 #include "emulators/spray_circuit_params.h"
 #include "emulators/vehicle_plant.h"
-#include "emulators/wheel_encoder.h"
+#include "emulators/wheel_encoder_params.h"
 #include "harness/spec/case_spec.h"
 
 namespace rig::harness {
