@@ -101,6 +101,7 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
         {"stops-answering", "node_unresponsive"},
         {"reads-truth-topic", "topic_role_violation"},
         {"forges-truth-topic", "topic_role_violation"},
+        {"wrong-section-count", "malformed_command"},
     };
     ASSERT_EQ(results.at("cases").size(), broken.size() + errors.size() + 4) << results.dump(2);
     for (const auto& [name, metrics] : broken) {
@@ -148,6 +149,26 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
     const std::string forger_error = find_case(results, "forges-truth-topic-seed1")->at("error").get<std::string>();
     EXPECT_NE(forger_error.find("node 'controller': writes truth topic truth/hydraulics"), std::string::npos)
         << forger_error;
+
+    // The section command for a fourth section fails the case at the instant it
+    // was sent, named; the trace keeps it as the last section command.
+    const std::string malformed_error = find_case(results, "wrong-section-count-seed1")->at("error").get<std::string>();
+    const std::regex malformed_text(
+        R"(node 'controller': actuator/section_valves/open at t=([0-9]+\.[0-9]{3}) s: )"
+        R"(open_mask 15 sets bit 3, but the boom has 3 sections \(bits 0-2\))");
+    std::smatch malformed_at;
+    ASSERT_TRUE(std::regex_search(malformed_error, malformed_at, malformed_text)) << malformed_error;
+    const fs::path malformed_trace = out / "run" / "cases" / "wrong-section-count-seed1" / "trace.sqlite";
+    const std::string last_sections = read_all_command(
+        "sqlite3 '" + malformed_trace.string() +
+        "' \"select t_ns, json from samples where topic = 'actuator/section_valves/open' order by t_ns desc, round desc limit 1\"");
+    const auto last_bar = last_sections.find('|');
+    ASSERT_NE(last_bar, std::string::npos) << last_sections;
+    EXPECT_NEAR(static_cast<double>(std::stoll(last_sections.substr(0, last_bar))) / 1e9, std::stod(malformed_at[1]), 0.0005)
+        << last_sections;
+    EXPECT_NE(last_sections.find(R"("open_mask":15)"), std::string::npos) << last_sections;
+    // When the first pass starts spraying (10.64 s on seed 1, after the 10 s wait), not at t = 0.
+    EXPECT_GT(std::stod(malformed_at[1]), 5.0) << malformed_error;
 
     // The crashed controller's trace keeps every sample up to the crash (20 s), and says why it ends.
     const fs::path crashed = out / "run" / "cases" / "crashes-mid-case-seed1" / "trace.sqlite";
