@@ -120,6 +120,23 @@ TEST(ShardAndMerge, TheMergedShardsAreTheSuiteRunAtOnce) {
     const auto schema = run_shell("xmllint --noout --schema " + quoted(RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd") +
                                   " " + quoted(dir / "merged" / "junit.xml") + " 2>&1");
     EXPECT_EQ(schema.exit_code, 0) << schema.output;
+
+    // A shard whose recorded number its trace does not give: exit status 5
+    // (the judging or the shard changed, not the controller), said last.
+    nlohmann::json shard_results = nlohmann::json::parse(read_all(dir / "shard-2" / "results.json"));
+    nlohmann::json& changed = shard_results.at("cases").at(0);
+    ASSERT_FALSE(changed.at("metrics").empty()) << changed.dump(2);
+    changed.at("metrics").begin().value() = 1e9;
+    std::ofstream(dir / "shard-2" / "results.json") << shard_results.dump(1);
+    const auto differing = run_shell(rig + " merge " + quoted(dir / "shard-1") + " " + quoted(dir / "shard-2") +
+                                     " --out " + quoted(dir / "merged-differing") + " 2>&1");
+    EXPECT_EQ(differing.exit_code, 5) << differing.output;
+    EXPECT_NE(differing.output.find("differs: " + changed.at("name").get<std::string>()), std::string::npos)
+        << differing.output;
+    EXPECT_NE(differing.output.find("difference(s) from the results the shards recorded: the judging changed, whatever "
+                                    "the verdicts (exit status 5)\n"),
+              std::string::npos)
+        << differing.output;
 }
 
 TEST(ShardAndMerge, MergesThatCannotBeRightAreRefusedBeforeWriting) {

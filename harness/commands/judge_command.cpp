@@ -107,6 +107,31 @@ std::vector<std::string> differences_from_run(const CaseResult& now, const nlohm
     return {now.name + ": not in " + results_file.string()};
 }
 
+// The exit status of a re-judging with `differences` from the recorded
+// results: kExitRejudgedDiffers first, then as `rig run` (1 failed, 3 invalid, 0).
+int rejudged_exit_status(const RunSummary& summary, std::size_t differences) {
+    if (differences > 0) return kExitRejudgedDiffers;
+    if (summary.failed > 0) return 1;
+    return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
+}
+
+// Its last line: "re-judged: every metric, verdict and digest as recorded;
+// 2 case(s) failed, as recorded (exit status 1)", or the differences' count
+// and exit status 5. `recorded_by`: "recorded", "the shards recorded".
+std::string rejudged_last_line(const RunSummary& summary, std::size_t differences, const std::string& recorded_by) {
+    if (differences > 0) {
+        return "re-judged: " + std::to_string(differences) + " difference(s) from the results " + recorded_by +
+               ": the judging changed, whatever the verdicts (exit status " + std::to_string(kExitRejudgedDiffers) + ")";
+    }
+    std::string line = "re-judged: every metric, verdict and digest as " + recorded_by;
+    if (summary.failed > 0) {
+        line += "; " + std::to_string(summary.failed) + " case(s) failed, as recorded (exit status 1)";
+    } else if (summary.invalid > 0) {
+        line += "; " + std::to_string(summary.invalid) + " case(s) invalid, as recorded (exit status 3)";
+    }
+    return line;
+}
+
 }  // namespace
 
 int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err) {
@@ -173,14 +198,13 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
         }
     }
     out << result_table(results, summary, colour_wanted(STDOUT_FILENO));
-    if (options.check) {
-        for (const std::string& difference : differing) out << "differs: " << difference << "\n";
-        out << (differing.empty() ? "re-judged: every metric, verdict and digest as recorded\n"
-                                  : "re-judged: " + std::to_string(differing.size()) + " difference(s)\n");
-    }
     if (!options.out_dir.empty()) out << "results: " << (options.out_dir / "results.json").string() << "\n";
-    if (summary.failed > 0 || !differing.empty()) return 1;
-    return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
+    if (options.check) {
+        // Last: a CI reads from it whether the controller failed or the judging changed.
+        for (const std::string& difference : differing) out << "differs: " << difference << "\n";
+        out << rejudged_last_line(summary, differing.size(), "recorded") << "\n";
+    }
+    return rejudged_exit_status(summary, differing.size());
 }
 
 int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std::ostream& err) {
@@ -248,13 +272,11 @@ int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std
         return 2;
     }
     out << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    out << "merged " << results.size() << " cases from " << shards.size() << " shards into "
+        << (options.out_dir / "results.json").string() << "\n";
     for (const std::string& difference : differing) out << "differs: " << difference << "\n";
-    out << "merged " << results.size() << " cases from " << shards.size() << " shards; "
-        << (differing.empty() ? "every metric, verdict and digest as the shards recorded\n"
-                              : std::to_string(differing.size()) + " difference(s) from the shards\n");
-    out << "results: " << (options.out_dir / "results.json").string() << "\n";
-    if (summary.failed > 0 || !differing.empty()) return 1;
-    return summary.invalid > 0 ? 3 : 0;
+    out << rejudged_last_line(summary, differing.size(), "the shards recorded") << "\n";
+    return rejudged_exit_status(summary, differing.size());
 }
 
 JudgeCommand::JudgeCommand(CLI::App& app) {

@@ -61,8 +61,8 @@ public:
     virtual void run_completed(TimeNs end_ns) { (void)end_ns; }
     // After the run, whatever its ending: what the trace keeps besides its
     // samples (seed 000: the spray on the ground, the faults injected) and the
-    // facts the system adds to the run's (seed 001: commands the plant refused,
-    // frames rendered); `case_dir` takes files for the report (camera frames).
+    // facts the system adds to the run's (seed 001: frames rendered); `case_dir`
+    // takes files for the report (camera frames).
     virtual void finish(TraceFile& trace, RunFacts& facts, const std::filesystem::path& case_dir) = 0;
 };
 

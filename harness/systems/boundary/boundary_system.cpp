@@ -64,7 +64,6 @@ public:
     std::vector<Node*> nodes() override { return all_; }
 
     void finish(TraceFile& trace, RunFacts& facts, const std::filesystem::path& case_dir) override {
-        facts.system["plant_rejected_duty_commands"] = plant_.rejected_commands();
         nlohmann::json report_frames = nlohmann::json::array();
         for (std::size_t c = 0; c < cameras_.size(); ++c) {
             facts.system[cameras_[c]->name() + "_frames"] = cameras_[c]->frames_rendered();
