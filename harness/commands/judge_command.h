@@ -36,6 +36,10 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
 // name found in two shards, a shard without results.json, or a DIR that is not
 // new or empty are refused before anything is written (exit 2). Exit as
 // `rig run`: 1 if a case failed or differs from its shard, 3 if only invalid.
+// The outputs of `rig sweep --shard I/N` (a sweep.json in each) are joined
+// into one sweep instead (harness/report/sweep_shard.h): every shard of one
+// sweep, once, or nothing is written (exit 2); a mix of run and sweep outputs
+// is refused. Exit as `rig sweep`: 1 if a run did not pass.
 struct MergeCommandOptions {
     std::vector<std::string> shard_dirs;
     std::filesystem::path out_dir;
