@@ -3,6 +3,7 @@
 // one is worse upwards (a limit is an upper bound), and the patterns pick the
 // family a numbered metric belongs to.
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -34,6 +35,18 @@ TEST(MetricDirection, EveryMetricOfTheGoldenRunsIsDeclared) {
         }
     }
     EXPECT_GT(checked, 100u);
+}
+
+// docs/metrics.md "Worse is" prints every declaration: the page and the table stay in step.
+TEST(MetricDirection, EveryDeclarationIsInTheMetricsPage) {
+    std::ifstream file(std::string(RIG_SOURCE_DIR) + "/docs/metrics.md");
+    ASSERT_TRUE(file) << "docs/metrics.md";
+    const std::string page((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    for (const auto& declaration : rig::harness::metric_declarations()) {
+        const std::string row = "| `" + std::string(declaration.pattern) + "` | " +
+                                std::string(rig::harness::worse_direction_name(declaration.worse)) + " |";
+        EXPECT_NE(page.find(row), std::string::npos) << "docs/metrics.md lacks the row " << row;
+    }
 }
 
 TEST(MetricDirection, NumberedFamiliesFindTheirOwnRule) {

@@ -2,6 +2,7 @@
 // The table of subcommands is below; each lives beside what it runs:
 //   rig run, rig sweep          harness/commands/run_command.h
 //   rig judge, rig merge        harness/commands/judge_command.h
+//   rig compare                 harness/commands/compare_command.h
 //   rig bench                   harness/commands/bench_command.h
 //   rig dds-check               harness/commands/dds_check_command.h
 //   rig mcap                    harness/commands/mcap_command.h
@@ -23,6 +24,7 @@
 #include "harness/bench/bench_serial.h"
 #include "harness/bench/nmea_decode_tool.h"
 #include "harness/commands/bench_command.h"
+#include "harness/commands/compare_command.h"
 #include "harness/commands/dds_check_command.h"
 #include "harness/commands/judge_command.h"
 #include "harness/commands/mcap_command.h"
@@ -120,6 +122,7 @@ int main(int argc, char** argv) {
     commands.push_back(std::make_unique<JudgeCommand>(app));
     commands.push_back(std::make_unique<MergeCommand>(app));
     commands.push_back(std::make_unique<SweepCommand>(app));
+    commands.push_back(std::make_unique<CompareCommand>(app));
     commands.push_back(std::make_unique<NmeaCommand>(app));
     commands.push_back(std::make_unique<PtyBenchCommand>(app));
     commands.push_back(std::make_unique<HidBenchCommand>(app));

@@ -11,6 +11,9 @@
 
 #include "harness/cli/cli_checks.h"
 #include "harness/judge/verdict.h"
+#include "harness/output/atomic_file.h"
+#include "harness/regression/bencher_format.h"
+#include "harness/regression/run_samples.h"
 #include "harness/report/html_report.h"
 #include "harness/report/results_writer.h"
 #include "harness/report/sweep.h"
@@ -161,8 +164,22 @@ std::unique_ptr<RunObserver> progress_observer(Verbosity verbosity, int jobs,
     return std::make_unique<CaseLineLog>(std::cerr, verbosity);
 }
 
+// `--bmf FILE`: the metrics just written, in Bencher's format as well
+// (harness/regression/bencher_format.h); false (told) when it cannot be written.
+bool write_bencher_file(const std::string& command, const std::string& bmf_file, const nlohmann::json& written,
+                        const std::string& kind, const std::filesystem::path& source) {
+    if (bmf_file.empty()) return true;
+    try {
+        write_file_atomically(bmf_file, bencher_metric_format(run_samples_from_json(written, kind, source)).dump(1) + "\n");
+        return true;
+    } catch (const std::exception& error) {
+        std::cerr << "rig " << command << ": --bmf " << bmf_file << " not written: " << error.what() << "\n";
+        return false;
+    }
+}
+
 int run_command(const std::vector<std::string>& inputs, const RunOptions& options,
-                const std::optional<Shard>& shard, Verbosity verbosity) {
+                const std::optional<Shard>& shard, Verbosity verbosity, const std::string& bmf_file) {
     std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, shard);
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
@@ -214,6 +231,10 @@ int run_command(const std::vector<std::string>& inputs, const RunOptions& option
         if (verbosity == Verbosity::verbose) std::cout << result_details(results);
     }
     for (const std::string& problem : report_problems) std::cerr << "rig: report: " << problem << "\n";
+    if (results_problem.empty() &&
+        !write_bencher_file("run", bmf_file, results_json(results, summary), "run", options.out_dir / "results.json")) {
+        results_problem = "--bmf " + bmf_file + " could not be written";
+    }
     if (!results_problem.empty()) {
         std::cerr << "rig: results not written: " << results_problem << "\n";
         for (const std::string& name : remove_stale_results(options.out_dir)) {
@@ -266,6 +287,7 @@ struct SweepArguments {
     std::uint64_t seeds = 0;
     std::uint64_t first_seed = 1;
     std::string keep_traces = "failed";
+    std::string bmf_file;
     std::optional<Shard> shard;
 };
 
@@ -322,6 +344,9 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
     if (sweep.shard) json["shard"] = sweep_shard_json(*sweep.shard, specs, runs_in_sweep, instances, results);
     try {
         write_sweep_files(options.out_dir, json, cases, info);
+        if (!write_bencher_file("sweep", sweep.bmf_file, json, "sweep", options.out_dir / "sweep.json")) {
+            return kExitResultsNotWritten;
+        }
     } catch (const std::exception& error) {
         std::cout << table;
         std::cerr << "rig sweep: results not written: " << error.what() << "\n";
@@ -355,6 +380,7 @@ RunCommand::RunCommand(CLI::App& app) : options_(default_run_options()) {
     shard_option_ = run->add_option(
         "--shard", shard_text_,
         "I/N: run only shard I of N of the cases (by name, stable), e.g. one job of a CI matrix; rig merge joins them");
+    run->add_option("--bmf", bmf_file_, "also write every case's metrics in Bencher's JSON format to this file");
     run->add_flag("--in-process", options_.in_process,
                   "software-in-the-loop: run each lockstep case's controller from its plugin inside the rig's process "
                   "(a case's controller.in_process wins; others run as processes, saying why)");
@@ -387,7 +413,7 @@ int RunCommand::run() {
     std::optional<Shard> shard;
     if (!shard_option_value(shard_option_, shard_text_, "rig run", shard)) return 2;
     const auto verbosity = quiet_ ? Verbosity::quiet : verbose_ ? Verbosity::verbose : Verbosity::normal;
-    return run_command(inputs_, options, shard, verbosity);
+    return run_command(inputs_, options, shard, verbosity, bmf_file_);
 }
 
 SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
@@ -412,12 +438,13 @@ SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
                                       "I/N: run only shard I of N of the sweep's runs (case and seed pairs, dealt in "
                                       "turn), e.g. one job of a CI matrix; rig merge joins them");
     sweep->add_flag("--quiet,-q", quiet_, "print only the summary line: no progress, no table");
+    sweep->add_option("--bmf", bmf_file_, "also write every case's metrics (median, min, max) in Bencher's JSON format to this file");
 }
 
 bool SweepCommand::parsed() const { return command_->parsed(); }
 
 int SweepCommand::run() {
-    SweepArguments sweep{seeds_, first_seed_, keep_traces_, std::nullopt};
+    SweepArguments sweep{seeds_, first_seed_, keep_traces_, bmf_file_, std::nullopt};
     if (!shard_option_value(shard_option_, shard_text_, "rig sweep", sweep.shard)) return 2;
     return sweep_command(inputs_, options_, sweep, quiet_ ? Verbosity::quiet : Verbosity::normal);
 }

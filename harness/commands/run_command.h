@@ -49,6 +49,7 @@ private:
     bool quiet_ = false;
     bool verbose_ = false;
     bool dds_security_ = false;
+    std::string bmf_file_;
 };
 
 class SweepCommand final : public Subcommand {
@@ -69,6 +70,7 @@ private:
     std::string shard_text_;
     CLI::Option* shard_option_ = nullptr;
     bool quiet_ = false;
+    std::string bmf_file_;
 };
 
 // The help text of --no-pin, shared with `rig bench`.

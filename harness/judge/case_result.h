@@ -15,7 +15,8 @@
 namespace rig::harness {
 
 struct CaseResult {
-    std::string name;
+    std::string name;               // the run's name: the case's, or NAME-seedN for a case with `seeds:`
+    std::string case_name;          // the case's own name (empty in traces from before it was recorded)
     std::string file;               // the case file
     bool passed = false;            // verdict, including the expect.fail logic (judge_case)
     bool expected_failure = false;  // the case has expect.fail (a negative case)
@@ -34,6 +35,14 @@ struct CaseResult {
     std::string expectation_set_aside;
     std::string trace_sha256;
     std::string trace_path;
+    // What the run was run with (harness/run/run_identity.h): the case without its
+    // controller section, the controller's program or plugin, and its
+    // configuration; empty when not known (an external board, an older trace).
+    std::string case_sha256;
+    std::string controller_sha256;
+    std::string controller_config_sha256;
+    // The case's `compare.min_effect`: rig compare's minimum effects over the declared ones.
+    std::map<std::string, double> min_effects;
     double sim_seconds = 0.0;
     double wall_seconds = 0.0;
     double startup_wall_seconds = 0.0;  // of wall_seconds: process start, DDS discovery, hello

@@ -20,6 +20,7 @@ void add_to_json(const JudgingPlan& plan, nlohmann::json& json) {
     json["scenario"] = plan.scenario;
     json["limits"] = plan.limits;
     json["expect"] = {{"fail", plan.expect_fail}, {"error", plan.expect_error}, {"set_aside", plan.expect_set_aside}};
+    if (!plan.min_effects.empty()) json["min_effects"] = plan.min_effects;
 }
 
 const nlohmann::json& plan_key(const nlohmann::json& node, const std::string& key, const std::string& path) {
@@ -38,6 +39,7 @@ JudgingPlan judging_plan_from_json(const nlohmann::json& json) {
         plan.expect_error = at(expect, "error", "expect.").get<std::string>();
         // Traces from before expectations could be set aside have no reason.
         if (expect.contains("set_aside")) plan.expect_set_aside = at(expect, "set_aside", "expect.").get<std::string>();
+        if (json.contains("min_effects")) plan.min_effects = json.at("min_effects").get<std::map<std::string, double>>();
         return plan;
     } catch (const nlohmann::json::exception& error) {
         throw std::runtime_error(std::string("judging plan: ") + error.what());
@@ -119,10 +121,14 @@ CaseRun judge_trace(const RecordedTrace& trace, const SystemJudge& system) {
     CaseFigures& figures = run.figures;
     result.name = trace.meta_or("case", trace.file.parent_path().filename().string());
     result.file = trace.meta_or("case_file");
+    result.case_name = trace.meta_or("case_name");
     result.mode = trace.meta_or("mode", "lockstep");
     result.wiring = trace.meta_or("wiring");
     result.trace_sha256 = trace.meta_or("trace_sha256");
     result.trace_path = trace.file.string();
+    result.case_sha256 = trace.meta_or("case_sha256");
+    result.controller_sha256 = trace.meta_or("controller_sha256");
+    result.controller_config_sha256 = trace.meta_or("controller_config_sha256");
     try {
         result.seed = std::stoull(trace.meta_or("seed", "0"));
         result.sim_seconds = ns_to_seconds(std::stoll(trace.meta_or("end_ns", "0")));
@@ -147,6 +153,7 @@ CaseRun judge_trace(const RecordedTrace& trace, const SystemJudge& system) {
         const nlohmann::json judging = nlohmann::json::parse(trace.meta_or("judging", "null"));
         const JudgingPlan plan = judging_plan_from_json(judging);
         result.limits = plan.limits;
+        result.min_effects = plan.min_effects;
         result.expected_error = plan.expect_error;
         result.expectation_set_aside = plan.expect_set_aside;
         // The trace says who touched what, whatever the run noticed live.

@@ -34,6 +34,8 @@ struct JudgingPlan {
     // Non-empty: the case's expectation was set aside, and why (applied_expectation,
     // harness/spec/case_spec.h); the run is judged on its limits alone.
     std::string expect_set_aside;
+    // The case's `compare.min_effect` (rig compare's minimum effects); absent in older traces.
+    std::map<std::string, double> min_effects;
 };
 // Writes the keys above into `json` (an object): scenario, limits, expect.
 void add_to_json(const JudgingPlan& plan, nlohmann::json& json);

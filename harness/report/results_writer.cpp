@@ -132,6 +132,26 @@ RunSummary summarize(const std::vector<CaseResult>& results) {
 
 // ---------------------------------------------------------------- outputs
 
+namespace {
+
+// A recorded fact, or null when the run did not record it.
+nlohmann::json text_or_null(const std::string& text) {
+    return text.empty() ? nlohmann::json(nullptr) : nlohmann::json(valid_utf8(text));
+}
+
+}  // namespace
+
+void add_run_identity(const CaseResult& result, nlohmann::json& run) {
+    run["case"] = text_or_null(result.case_name);
+    run["case_sha256"] = text_or_null(result.case_sha256);
+    run["controller_sha256"] = text_or_null(result.controller_sha256);
+    run["controller_config_sha256"] = text_or_null(result.controller_config_sha256);
+    run["min_effects"] = result.min_effects;
+    nlohmann::json not_measured = nlohmann::json::object();
+    for (const auto& [name, why] : result.not_measured) not_measured[valid_utf8(name)] = valid_utf8(why);
+    run["not_measured"] = std::move(not_measured);
+}
+
 nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary) {
     nlohmann::json cases = nlohmann::json::array();
     for (const CaseResult& result : results) {
@@ -141,8 +161,6 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
         for (const auto& [name, value] : result.limits) limits[valid_utf8(name)] = value;
         nlohmann::json failures = nlohmann::json::array();
         for (const std::string& failure : result.failures) failures.push_back(valid_utf8(failure));
-        nlohmann::json not_measured = nlohmann::json::object();
-        for (const auto& [name, why] : result.not_measured) not_measured[valid_utf8(name)] = valid_utf8(why);
         nlohmann::json one_case = {
             {"name", valid_utf8(result.name)},
             {"file", valid_utf8(result.file)},
@@ -154,13 +172,13 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
                                                                            : nlohmann::json(valid_utf8(result.expectation_set_aside))},
             {"seed", result.seed},
             {"metrics", std::move(metrics)},
-            {"not_measured", std::move(not_measured)},
             {"limits", std::move(limits)},
             {"failures", std::move(failures)},
             {"error", result.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(valid_utf8(result.error))},
             {"error_kind", result.error_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(result.error_kind)},
             {"trace_sha256", valid_utf8(result.trace_sha256)},
             {"trace_path", valid_utf8(result.trace_path)},
+
             {"sim_seconds", result.sim_seconds},
             {"wall_seconds", result.wall_seconds},
             {"startup_wall_seconds", result.startup_wall_seconds},
@@ -170,6 +188,7 @@ nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSum
             {"mode", valid_utf8(result.mode)},
             {"controller_mode", valid_utf8(result.controller_mode)},
         };
+        add_run_identity(result, one_case);
         if (!result.in_process_refused.empty()) one_case["in_process_refused"] = valid_utf8(result.in_process_refused);
         if (result.mode == "realtime") {
             nlohmann::json jitter = nlohmann::json::object();

@@ -55,6 +55,10 @@ RunSummary summarize(const std::vector<CaseResult>& results);
 // UTF-8 in any string is replaced by U+FFFD, so dump() never throws. Paths are
 // written as the results hold them: write_results() makes them relative to its folder.
 nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary);
+// A run's identity and what it did not measure, as results.json and sweep.json
+// write them for each run: `case`, `case_sha256`, `controller_sha256`,
+// `controller_config_sha256` (null when not recorded), `min_effects`, `not_measured`.
+void add_run_identity(const CaseResult& result, nlohmann::json& run);
 
 // JUnit XML, valid against Jenkins xunit's JUnit schema (tests/data/jenkins-junit-10.xsd):
 // <testsuites> with one <testsuite> per case (that schema allows properties on a

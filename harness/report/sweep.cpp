@@ -211,13 +211,16 @@ nlohmann::json sweep_json(const std::vector<CaseSweep>& cases, const std::vector
             const CaseResult& result = results[i];
             nlohmann::json metrics = nlohmann::json::object();
             for (const auto& [name, value] : result.metrics) metrics[name] = json_number(value);
-            seeds.push_back({{"seed", runs[i].seed},
-                             {"run", runs[i].name},
-                             {"passed", case_passed(result)},
-                             {"metrics", std::move(metrics)},
-                             {"failures", result.failures},
-                             {"error", result.error.empty() ? nlohmann::json() : nlohmann::json(valid_utf8(result.error))},
-                             {"trace_sha256", result.trace_sha256}});
+            nlohmann::json seed = {{"seed", runs[i].seed},
+                                   {"run", runs[i].name},
+                                   {"passed", case_passed(result)},
+                                   {"metrics", std::move(metrics)},
+                                   {"failures", result.failures},
+                                   {"error", result.error.empty() ? nlohmann::json() : nlohmann::json(valid_utf8(result.error))},
+                                   {"trace_sha256", result.trace_sha256}};
+            // What rig compare needs of each run (docs/regression.md).
+            add_run_identity(result, seed);
+            seeds.push_back(std::move(seed));
         }
         item["seeds"] = std::move(seeds);
         json["cases"].push_back(std::move(item));

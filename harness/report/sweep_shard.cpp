@@ -21,7 +21,6 @@ nlohmann::json sweep_shard_json(const Shard& shard, const std::vector<CaseSpec>&
         const CaseResult& result = results[i];
         runs.push_back({{"run", held[i].name},
                         {"limits", result.limits},
-                        {"not_measured", result.not_measured},
                         {"sim_seconds", result.sim_seconds},
                         {"error_kind", result.error_kind},
                         {"expected_error", result.expected_error}});
@@ -126,7 +125,8 @@ ShardRead read_shard(const SweepShardOutput& output) {
 }
 
 // A run as far as the bands, pass rates and totals need it: its seeds entry
-// (verdict, metrics, failures, error, digest) and its shard.runs entry.
+// (verdict, metrics, what was not measured, failures, error, digest) and its
+// shard.runs entry.
 CaseResult rebuilt_result(const nlohmann::json& entry, const nlohmann::json& extra) {
     CaseResult result;
     result.name = entry.at("run").get<std::string>();
@@ -139,8 +139,8 @@ CaseResult rebuilt_result(const nlohmann::json& entry, const nlohmann::json& ext
     result.failures = entry.at("failures").get<std::vector<std::string>>();
     result.error = entry.at("error").is_null() ? "" : entry.at("error").get<std::string>();
     result.trace_sha256 = entry.at("trace_sha256").get<std::string>();
+    result.not_measured = entry.at("not_measured").get<std::map<std::string, std::string>>();
     result.limits = extra.at("limits").get<std::map<std::string, double>>();
-    result.not_measured = extra.at("not_measured").get<std::map<std::string, std::string>>();
     result.sim_seconds = extra.at("sim_seconds").get<double>();
     result.error_kind = extra.at("error_kind").get<std::string>();
     result.expected_error = extra.at("expected_error").get<std::string>();

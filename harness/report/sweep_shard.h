@@ -8,8 +8,8 @@
 // shard_of_run), with the whole sweep's seed list, plus a "shard" object:
 // which shard of how many, how many runs the whole sweep has, and what the
 // bands of the whole sweep need that a sweep.json does not otherwise keep:
-// each case's paper numbers and each held run's limits, unmeasured metrics,
-// simulated seconds and error kinds. The merge keeps each run's entry in
+// each case's paper numbers and each held run's limits, simulated seconds and
+// error kinds. The merge keeps each run's entry in
 // `cases[].seeds` as its shard wrote it, and computes the bands, pass rates
 // and totals again from every run, in the order one machine runs them, so
 // they come out bit for bit.

@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "harness/judge/verdict.h"
+#include "harness/run/run_identity.h"
 #include "harness/run/run_interrupt.h"
 #include "harness/run/run_progress.h"
 #include "harness/session/board_attach.h"
@@ -19,6 +20,7 @@
 #include "harness/session/in_process_controller.h"
 #include "harness/session/line_noise.h"
 #include "harness/systems/systems.h"
+#include "harness/trace/sha256.h"
 #include "harness/trace/trace_recorder.h"
 #include "rig/host/child_process.h"
 #include "rig/host/cpu_lease.h"
@@ -37,10 +39,13 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
     CaseRun run;
     CaseResult& result = run.result;
     result.name = run_name;
+    result.case_name = spec.name;
     result.file = spec.source_path.string();
     result.seed = seed;
+    result.case_sha256 = case_content_sha256(spec);
     result.mode = std::string(to_string(spec.mode));
     result.limits = effective_limits(spec);
+    result.min_effects = spec.min_effects;
     const ExpectSpec expect = applied_expectation(spec, &result.expectation_set_aside);
     result.expected_error = expect.error;
     result.error_kind = std::string(to_string(kind));
@@ -60,6 +65,7 @@ std::string judging_plan_json(const CaseSpec& spec, const SystemRun& world) {
     JudgingPlan plan;
     plan.scenario = spec.system->scenario();
     plan.limits = effective_limits(spec);
+    plan.min_effects = spec.min_effects;
     const ExpectSpec expect = applied_expectation(spec, &plan.expect_set_aside);
     plan.expect_fail = expect.fail;
     plan.expect_error = expect.error;
@@ -231,6 +237,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         TraceRecorder trace(dds, trace_file);
         world->record(trace);
         trace.file().set_meta("case", run_name);
+        trace.file().set_meta("case_name", spec.name);
         trace.file().set_meta("case_file", spec.source_path.string());
         trace.file().set_meta("case_yaml", spec.source_text);
         trace.file().set_meta("system", std::string(system.name()));
@@ -238,6 +245,16 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.file().set_meta("mode", std::string(to_string(spec.mode)));
         trace.file().set_meta("seed", std::to_string(seed));
         trace.file().set_meta("controller_command", session.controller_command_line());
+        // What `rig compare` sets side by side (harness/run/run_identity.h); not in the digest.
+        trace.file().set_meta("case_sha256", case_content_sha256(spec));
+        if (!spec.wiring.external_controller) {
+            const bool ran_in_process = session.controller_mode() == "in_process";
+            const std::filesystem::path plugin = ran_in_process ? *placement.plugin : std::filesystem::path();
+            trace.file().set_meta("controller_sha256", file_sha256(controller_file_of(spec, plugin, executable)));
+            Sha256 config;
+            config.add(controller_config_text(spec));
+            trace.file().set_meta("controller_config_sha256", config.hex());
+        }
         trace.file().set_meta("wiring", session.wires().description);
         trace.file().set_meta("dds_domain", std::to_string(session.domain_id()));
         trace.file().set_meta("harness_guid_prefix", dds.guid_prefix());

@@ -12,19 +12,24 @@
 
 namespace rig::harness {
 
+std::string controller_config_text(const CaseSpec& spec) {
+    YAML::Node section = spec.controller.params.present ? YAML::Clone(spec.controller.params.node) : YAML::Node();
+    if (section.IsMap()) {
+        for (std::string_view key : kControllerRigKeys) section.remove(std::string(key));
+    }
+    if (section.IsNull()) return "{}";
+    YAML::Emitter out;
+    out << section;
+    return out.c_str();
+}
+
 namespace {
 
 
 // The controller's parameters as their own YAML file (the case section minus `command`).
 void write_controller_config(const CaseSpec& spec, const std::filesystem::path& file) {
-    YAML::Node section = spec.controller.params.present ? YAML::Clone(spec.controller.params.node) : YAML::Node();
-    if (section.IsMap()) {
-        for (std::string_view key : kControllerRigKeys) section.remove(std::string(key));
-    }
-    YAML::Emitter out;
-    out << section;
     std::ofstream(file) << "# the `controller:` section of " << spec.source_path.string() << "\n"
-                        << (section.IsNull() ? "{}" : out.c_str()) << "\n";
+                        << controller_config_text(spec) << "\n";
 }
 
 std::string log_tail(const std::filesystem::path& log, std::size_t max_lines) {

@@ -25,6 +25,11 @@
 
 namespace rig::harness {
 
+// The controller's configuration as it is given to the controller
+// (controller.yaml): the case's `controller:` section without the rig's own
+// keys (command, plugin, in_process), "{}" when the case has none.
+std::string controller_config_text(const CaseSpec& spec);
+
 // The rig's ends of the bench wires a case asks for, and what the controller
 // process must be told to use the far ends.
 struct BenchWires {

@@ -116,17 +116,22 @@ ControllerSpec read_controller(const YamlSection& root) {
     return controller;
 }
 
+// A metric's name as a key of `section` (limits:, paper:, compare.min_effect:):
+// a few snake_case words ending with a unit; the name is repeated in every message.
+void check_metric_key(const YamlSection& section, const std::string& name) {
+    if (name.size() > 64) {
+        throw ConfigError(section.key_location(name), "metric name of " + std::to_string(name.size()) +
+                                                          " characters, at most 64");
+    }
+    if (const std::string problem = metric_name_problem(name); !problem.empty()) {
+        throw ConfigError(section.key_location(name), problem);
+    }
+}
+
 std::map<std::string, double> read_limits(const YamlSection& section) {
     std::map<std::string, double> limits;
     for (const std::string& name : section.keys()) {
-        // Metric names are a few words; the name is repeated in every message.
-        if (name.size() > 64) {
-            throw ConfigError(section.key_location(name), "metric name of " + std::to_string(name.size()) +
-                                                              " characters, at most 64");
-        }
-        if (const std::string problem = metric_name_problem(name); !problem.empty()) {
-            throw ConfigError(section.key_location(name), problem);
-        }
+        check_metric_key(section, name);
         // Limits are on metres, seconds, percent and counts of one case; no
         // metric the harness measures comes near a million of any of them.
         limits[name] = section.required_in_range<double>(name, Bounds::closed(-1e6, 1e6));
@@ -134,17 +139,25 @@ std::map<std::string, double> read_limits(const YamlSection& section) {
     return limits;
 }
 
+// `compare: { min_effect: { overlap_m: 0.1 } }`: the smallest shift `rig
+// compare` and `rig history` call news for this case's metrics, over the
+// declared defaults (harness/judge/metric_direction.h). Zero calls any
+// significant shift news; the range is a limit's.
+std::map<std::string, double> read_compare(const YamlSection& root) {
+    std::map<std::string, double> min_effects;
+    const YamlSection section = root.section("compare").section("min_effect");
+    for (const std::string& name : section.keys()) {
+        check_metric_key(section, name);
+        min_effects[name] = section.required_in_range<double>(name, Bounds::closed(0, 1e6));
+    }
+    return min_effects;
+}
+
 PaperPoints read_paper(const YamlSection& section) {
     PaperPoints paper;
     for (const std::string& name : section.keys()) {
         if (name == "source") continue;
-        if (name.size() > 64) {
-            throw ConfigError(section.key_location(name), "metric name of " + std::to_string(name.size()) +
-                                                              " characters, at most 64");
-        }
-        if (const std::string problem = metric_name_problem(name); !problem.empty()) {
-            throw ConfigError(section.key_location(name), problem);
-        }
+        check_metric_key(section, name);
         // The same range as a limit: the paper's numbers are of the same metrics.
         paper.values[name] = section.required_in_range<double>(name, Bounds::closed(-1e6, 1e6));
     }
@@ -316,6 +329,7 @@ CaseSpec read_case(const YamlSection& root, const std::filesystem::path& source_
     spec.controller = read_controller(root);
     spec.limits = read_limits(root.section("limits"));
     spec.paper = read_paper(root.section("paper"));
+    spec.min_effects = read_compare(root);
     spec.expect = read_expect(root.section("expect"));
     spec.timeouts = read_timeouts(root.section("timeouts"));
 

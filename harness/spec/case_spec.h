@@ -191,6 +191,9 @@ struct CaseSpec {
     // sweep draws them over the rig's bands (harness/report/sweep.h). Not a limit and
     // never part of the verdict.
     PaperPoints paper;
+    // `compare: { min_effect: {metric: shift} }`: this case's minimum effects for
+    // `rig compare` / `rig history`, over the declared defaults (docs/regression.md).
+    std::map<std::string, double> min_effects;
 };
 
 // Unit suffixes a metric (limit) name may end with, as `_<suffix>`.
