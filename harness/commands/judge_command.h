@@ -44,6 +44,10 @@ inline constexpr int kExitRejudgedDiffers = 5;
 // new or empty are refused before anything is written (exit 2). Exit as
 // `rig judge --check`: 5 if a case differs from its shard, else 1 if a case
 // failed, 3 if only invalid; the last line says which.
+// The outputs of `rig sweep --shard I/N` (a sweep.json in each) are joined
+// into one sweep instead (harness/report/sweep_shard.h): every shard of one
+// sweep, once, or nothing is written (exit 2); a mix of run and sweep outputs
+// is refused. Exit as `rig sweep`: 1 if a run did not pass.
 struct MergeCommandOptions {
     std::vector<std::string> shard_dirs;
     std::filesystem::path out_dir;
