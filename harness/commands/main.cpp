@@ -7,6 +7,7 @@
 //   rig bench                   harness/commands/bench_command.h
 //   rig dds-check               harness/commands/dds_check_command.h
 //   rig mcap                    harness/commands/mcap_command.h
+//   rig history                 harness/commands/history_command.h
 //   rig nmea decode             harness/bench/nmea_decode_tool.h
 //   rig pty, rig hid, rig emulate gnss, rig modbus serve   harness/bench/
 // A usage error (unknown command or option, missing or bad value) names the
@@ -28,6 +29,7 @@
 #include "harness/commands/compare_command.h"
 #include "harness/commands/dds_check_command.h"
 #include "harness/commands/diff_command.h"
+#include "harness/commands/history_command.h"
 #include "harness/commands/judge_command.h"
 #include "harness/commands/mcap_command.h"
 #include "harness/commands/run_command.h"
@@ -131,6 +133,7 @@ int main(int argc, char** argv) {
     commands.push_back(std::make_unique<HidBenchCommand>(app));
     commands.push_back(std::make_unique<EmulateBenchCommand>(app));
     commands.push_back(std::make_unique<McapCommand>(app));
+    commands.push_back(std::make_unique<HistoryCommand>(app));
     commands.push_back(std::make_unique<DdsCheckCommand>(app));
     commands.push_back(std::make_unique<SpeedBenchCommand>(app));
     commands.push_back(std::make_unique<ModbusCommand>(app));

@@ -120,6 +120,9 @@ RunSamples run_samples_from_json(const nlohmann::json& json, const std::string& 
         samples.rig_version = text_or_empty(json.at("rig"), "version");
         samples.rig_commit = text_or_empty(json.at("rig"), "commit");
     }
+    if (json.contains("started_utc") && json.at("started_utc").is_string()) {
+        samples.started_utc = json.at("started_utc").get<std::string>();
+    }
     std::map<std::string, CaseSamples> cases;
     const nlohmann::json& listed = json.at("cases");
     for (std::size_t index = 0; index < listed.size(); ++index) {

@@ -41,6 +41,8 @@ struct RunSamples {
     std::string kind;              // "run" or "sweep"
     std::string rig_version;
     std::string rig_commit;
+    // When the run or sweep started (sweep.json's started_utc); empty when the output does not say.
+    std::string started_utc;
     std::vector<CaseSamples> cases;  // by name
 };
 
