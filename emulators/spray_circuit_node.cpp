@@ -1,5 +1,6 @@
 #include "emulators/spray_circuit_node.h"
 
+#include "emulators/malformed_command.h"
 #include "idl/topics.h"
 
 namespace rig::emulators {
@@ -30,7 +31,13 @@ TimeNs SprayCircuitNode::step(TimeNs now_ns) {
                                  : relays.reverse()                   ? Drive::reverse
                                                                       : Drive::off);
     }
-    for (const auto& sections : sections_reader_->take_all()) circuit_.set_sections_commanded(sections.open_mask());
+    for (const auto& sections : sections_reader_->take_all()) {
+        // A section the boom does not have is no command the circuit can carry out: the run ends on it.
+        if (const auto problem = section_valves_problem(sections, circuit_.section_count())) {
+            throw malformed_command(topics::kSectionValves, now_ns, *problem);
+        }
+        circuit_.set_sections_commanded(sections.open_mask());
+    }
     for (const auto& unloading : unloading_reader_->take_all()) circuit_.set_unloading_open(unloading.open());
     if (now_ns >= next_truth_ns_) {
         truth_writer_->publish(circuit_.truth());

@@ -2,7 +2,9 @@
 // The spray circuit as a rig node: it takes the controller's actuator topics
 // (ball-valve relays, section valves, unloading valve) and applies them to the
 // plant at the instant they were published, and publishes truth/hydraulics at a
-// fixed rate for the trace and the harness's flow metrics.
+// fixed rate for the trace and the harness's flow metrics. A section-valve
+// command for a section the boom does not have ends the run
+// (malformed_command, emulators/malformed_command.h).
 //
 // Subscriptions: actuator/ball_valve/relays, actuator/section_valves/open,
 //                actuator/unloading_valve/open

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -302,8 +303,21 @@ TEST(BoundaryJudge, TheGroundIsEachStepsVolumeLaidAsTheFanBand) {
     EdgeProbe probe;
     probe.from_m = 1.0;
     probe.to_m = 2.0;
-    const auto m = excess_metrics("boundary_overrun", wet_edge_profile(layers[0], edge, probe));
+    std::map<std::string, std::string> not_measured;
+    const auto m = excess_metrics("boundary_overrun", wet_edge_profile(layers[0], edge, probe), not_measured);
     EXPECT_NEAR(m.at("boundary_overrun_mean_m"), 0.714 - 0.5, 0.02);
+}
+
+TEST(BoundaryJudge, AVolumeThatGoesBackIsAnErrorNotAStepClampedToZero) {
+    // delivered_l counts since the start: 2 mL then 1 mL is no step of -1 mL
+    // to leave out (the judge once laid max(0, ...)), but a trace that does not hold together.
+    const std::vector<NozzleStepTruth> steps = {step_at(0.0, 0.0, 0.002), step_at(0.005, 0.005, 0.001)};
+    try {
+        ground_from_truth(steps, small_plan());
+        FAIL() << "a delivered volume going back passed";
+    } catch (const std::runtime_error& error) {
+        EXPECT_EQ(std::string(error.what()), "truth/nozzles at t_ns 5000000: nozzle 0 delivered_l 0.001 L after 0.002 L (it only grows)");
+    }
 }
 
 TEST(BoundaryJudge, FlowPerDutyIsTheVolumeOverWholePwmPeriods) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -146,7 +147,9 @@ TEST(BoundaryLoop, DrivingOutStopsThePlantPastTheEdgeByTheLoopsDelay) {
     const LoopResult r = run_loop(route, 5, grid(-3, 3, -3, 3));
     EXPECT_EQ(r.rejected, 0u);
     const auto profile = hm::wet_edge_profile(r.total, edge_of(r.area, edge_near(r.area, {0, 0})), north_edge_probe());
-    const auto m = hm::excess_metrics("drive_out_excess", profile);
+    std::map<std::string, std::string> not_measured;
+    const auto m = hm::excess_metrics("drive_out_excess", profile, not_measured);
+    EXPECT_TRUE(not_measured.empty());
     ASSERT_EQ(m.at("drive_out_excess_stations"), 8.0);
     // From the centre crossing to the valves shut: the next epoch (0-0.1 s), the
     // RMC latency (0.05 s), the PWM latching the 0 % (0-0.111 s) and the stroke
@@ -170,7 +173,9 @@ TEST(BoundaryLoop, DrivingInStartsThePlantInsideTheEdge) {
     const Route2d route({{0.3, 10.0}, 180.0, 1.5}, {StraightSegment{16.0, 1.5, 0.5}, StraightSegment{2.25, 1.5, 0.5, true}});
     const LoopResult r = run_loop(route, 6, grid(-3, 3, -4, 2));
     const auto profile = hm::wet_edge_profile(r.total, edge_of(r.area, edge_near(r.area, {0, 0})), north_edge_probe());
-    const auto m = hm::excess_metrics("drive_in_excess", profile);
+    std::map<std::string, std::string> not_measured;
+    const auto m = hm::excess_metrics("drive_in_excess", profile, not_measured);
+    EXPECT_TRUE(not_measured.empty());
     ASSERT_EQ(m.at("drive_in_excess_stations"), 8.0);
     // The same 0.05-0.276 s delay now starts the spray 0.075-0.414 m inside;
     // half the band (0.05 m) reaches back toward the edge.
@@ -192,13 +197,15 @@ TEST(BoundaryLoop, AlongTheEdgeTheOutermostOpenNozzleSetsTheOverrun) {
     hm::EdgeProbe probe;
     probe.from_m = 6.0;  // north -14 ... -5: the boom passed with steady spray
     probe.to_m = 15.0;
-    const auto m = hm::excess_metrics("boundary_overrun", hm::wet_edge_profile(r.total, east, probe));
+    std::map<std::string, std::string> not_measured;
+    const auto m = hm::excess_metrics("boundary_overrun", hm::wet_edge_profile(r.total, east, probe), not_measured);
     ASSERT_EQ(m.at("boundary_overrun_stations"), 19.0);
     EXPECT_NEAR(m.at("boundary_overrun_mean_m"), 0.464, 0.02);
     EXPECT_LT(m.at("boundary_overrun_sd_m"), 0.01);
     std::vector<hm::EdgeProfile> per_nozzle;
     for (const hm::DoseRaster& layer : r.layers) per_nozzle.push_back(hm::wet_edge_profile(layer, east, probe));
-    const auto pn = hm::per_nozzle_excess_metrics("boundary_overrun", per_nozzle);
+    const auto pn = hm::per_nozzle_excess_metrics("boundary_overrun", per_nozzle, not_measured);
+    EXPECT_TRUE(not_measured.empty());
     EXPECT_NEAR(pn.at("boundary_overrun_nozzle4_mean_m"), 0.464, 0.02);
     EXPECT_EQ(pn.at("boundary_overrun_nozzle5_stations"), 0.0);  // never opened
     EXPECT_NEAR(pn.at("boundary_overrun_nozzle3_mean_m"), -0.036, 0.02);  // 0.714 - 0.75

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,15 +16,16 @@ namespace {
 
 using namespace rig::harness;
 
-// A 2 cm raster over east [-2, 2) x north [-2, 2), wet (dose 1 uL/cm^2) where `wet(e, n)` says so.
+// A 2 cm raster over east [-2, 2) x north [north_min, north_max), wet (dose 1
+// uL/cm^2) where `wet(e, n)` says so.
 template <class Fn>
-DoseRaster raster_where(Fn wet) {
+DoseRaster raster_where(Fn wet, double north_min_m = -2.0, double north_max_m = 2.0) {
     DoseRaster r;
     r.east0_m = -2.0;
-    r.north0_m = -2.0;
+    r.north0_m = north_min_m;
     r.cell_m = 0.02;
     r.nx = 200;
-    r.ny = 200;
+    r.ny = static_cast<std::size_t>(std::lround((north_max_m - north_min_m) / r.cell_m));
     r.dose_ul_cm2.assign(r.nx * r.ny, 0.0);
     for (std::size_t iy = 0; iy < r.ny; ++iy) {
         for (std::size_t ix = 0; ix < r.nx; ++ix) {
@@ -33,6 +35,27 @@ DoseRaster raster_where(Fn wet) {
         }
     }
     return r;
+}
+
+// A family's metrics: its values, and why the others have none.
+struct Measured {
+    std::map<std::string, double> values;
+    std::map<std::string, std::string> not_measured;
+};
+Measured excess(const std::string& prefix, const EdgeProfile& profile) {
+    Measured m;
+    m.values = excess_metrics(prefix, profile, m.not_measured);
+    return m;
+}
+Measured per_nozzle_excess(const std::string& prefix, const std::vector<EdgeProfile>& per_nozzle) {
+    Measured m;
+    m.values = per_nozzle_excess_metrics(prefix, per_nozzle, m.not_measured);
+    return m;
+}
+Measured centre_rule(const std::vector<CentreRuleSample>& samples, const rig::field2d::Polygon& area) {
+    Measured m;
+    m.values = centre_rule_metrics(samples, area, m.not_measured);
+    return m;
 }
 
 // The edge along north = 0 with the area to the south: from east +1 to east -1
@@ -72,7 +95,7 @@ TEST(BoundaryMetrics, ANozzleClosing0_1sLateAt1MetrePerSecondOverruns0_1m) {
         // first dry (0.100) probe: 0.0975, within a quarter cell of 0.1.
         EXPECT_NEAR(profile.excess_m[i], 0.1, 0.005) << "station " << i;
     }
-    const auto m = excess_metrics("boundary_overrun", profile);
+    const auto m = excess("boundary_overrun", profile).values;
     EXPECT_NEAR(m.at("boundary_overrun_mean_m"), 0.1, 0.005);
     EXPECT_NEAR(m.at("boundary_overrun_sd_m"), 0.0, 1e-12);
     EXPECT_EQ(m.at("boundary_overrun_stations"), 5.0);
@@ -89,15 +112,17 @@ TEST(BoundaryMetrics, ShortSprayIsNegativeAndUnreachedStationsAreDry) {
     EXPECT_NEAR(p.excess_m[2], -0.2, 0.005);
     EXPECT_TRUE(std::isnan(p.excess_m[3]));
     EXPECT_TRUE(std::isnan(p.excess_m[4]));
-    const auto m = excess_metrics("drive_in_excess", p);
+    const auto m = excess("drive_in_excess", p).values;
     EXPECT_NEAR(m.at("drive_in_excess_mean_m"), -0.2, 0.005);
     EXPECT_EQ(m.at("drive_in_excess_stations"), 2.0);
     EXPECT_EQ(m.at("drive_in_excess_stations_dry"), 3.0);
-    // No wet station at all: mean and SD are absent (a limit on them fails as missing).
-    const auto dry = excess_metrics("drive_out_excess", wet_edge_profile(raster_where([](double, double) { return false; }), kNorthEdge));
-    EXPECT_EQ(dry.count("drive_out_excess_mean_m"), 0u);
-    EXPECT_EQ(dry.count("drive_out_excess_sd_m"), 0u);
-    EXPECT_EQ(dry.at("drive_out_excess_stations_dry"), 5.0);
+    // No wet station at all: mean and SD have no value, and say why (a limit on them fails as not measured).
+    const Measured dry =
+        excess("drive_out_excess", wet_edge_profile(raster_where([](double, double) { return false; }), kNorthEdge));
+    EXPECT_EQ(dry.values.count("drive_out_excess_mean_m"), 0u);
+    EXPECT_EQ(dry.values.count("drive_out_excess_sd_m"), 0u);
+    EXPECT_EQ(dry.not_measured.at("drive_out_excess_mean_m"), "no wet ground at any station of the edge");
+    EXPECT_EQ(dry.values.at("drive_out_excess_stations_dry"), 5.0);
 }
 
 TEST(BoundaryMetrics, SlantedEdge) {
@@ -119,9 +144,9 @@ TEST(BoundaryMetrics, PerNozzleNames) {
     const DoseRaster wet_far = raster_where([](double, double n) { return n < 0.3; });
     const DoseRaster wet_near = raster_where([](double, double n) { return n < 0.1; });
     const DoseRaster dry = raster_where([](double, double) { return false; });
-    const auto m = per_nozzle_excess_metrics(
+    const auto m = per_nozzle_excess(
         "boundary_overrun", {wet_edge_profile(wet_near, kNorthEdge), wet_edge_profile(wet_far, kNorthEdge),
-                             wet_edge_profile(dry, kNorthEdge)});
+                             wet_edge_profile(dry, kNorthEdge)}).values;
     EXPECT_NEAR(m.at("boundary_overrun_nozzle0_mean_m"), 0.1, 0.005);
     EXPECT_NEAR(m.at("boundary_overrun_nozzle1_max_m"), 0.3, 0.005);
     EXPECT_EQ(m.at("boundary_overrun_nozzle2_stations"), 0.0);
@@ -129,6 +154,81 @@ TEST(BoundaryMetrics, PerNozzleNames) {
     // The ground's total is the sum of the layers: its edge is the farthest one.
     const DoseRaster total = sum_rasters({wet_near, wet_far, dry});
     EXPECT_NEAR(wet_edge_profile(total, kNorthEdge).excess_m[2], 0.3, 0.005);
+}
+
+TEST(BoundaryMetrics, TheProbeSpansTheJudgedGroundInsideAndOut) {
+    // The ground reaches 6 m outside the north edge and 4 m inside. A spray
+    // that went on 3.5 m past the edge, and one that stopped 3 m short of it,
+    // are measured where they are (the judge once searched only +-2 m).
+    const DoseRaster past = raster_where([](double, double n) { return n < 3.5; }, -4.0, 6.0);
+    const EdgeProfile far_out = wet_edge_profile(past, kNorthEdge);
+    for (std::size_t i = 0; i < far_out.excess_m.size(); ++i) {
+        EXPECT_EQ(far_out.finding[i], StationFinding::wet_edge);
+        EXPECT_NEAR(far_out.excess_m[i], 3.5, 0.005) << "station " << i;
+    }
+    EXPECT_NEAR(excess("drive_out_excess", far_out).values.at("drive_out_excess_mean_m"), 3.5, 0.005);
+    const DoseRaster short_of = raster_where([](double, double n) { return n < -3.0; }, -4.0, 6.0);
+    const Measured m = excess("drive_in_excess", wet_edge_profile(short_of, kNorthEdge));
+    EXPECT_NEAR(m.values.at("drive_in_excess_mean_m"), -3.0, 0.005);
+    EXPECT_EQ(m.values.at("drive_in_excess_stations_dry"), 0.0);
+}
+
+TEST(BoundaryMetrics, ProbesKeepTheirPlacesSoEveryExcessMeasuredBeforeIsTheSame) {
+    // The probes lie at 2 m - j x (a quarter cell), however far the ground
+    // reaches: the edge 0.1 m out is found between j = 380 (2 - 380 x 0.005
+    // rounds to just under 0.1 m: wet) and 379 (0.105 m, dry), to the last
+    // bit as when the probe started at +2 m.
+    for (const double north_max : {2.0, 3.0, 6.0}) {
+        const EdgeProfile p = wet_edge_profile(raster_where([](double, double n) { return n < 0.1; }, -2.0, north_max), kNorthEdge);
+        for (const double excess : p.excess_m) EXPECT_EQ(excess, (2.0 - 380.0 * 0.005) + 0.5 * 0.005) << north_max;
+    }
+}
+
+TEST(BoundaryMetrics, WetToTheEndOfTheGroundIsNotMeasuredNeverTheBound) {
+    // A controller that never shut off: wet up to where the ground ends, 2 m
+    // out. The old window reported 2.000 as the excess; the edge lies beyond.
+    const EdgeProfile p = wet_edge_profile(raster_where([](double, double) { return true; }), kNorthEdge);
+    for (std::size_t i = 0; i < p.excess_m.size(); ++i) {
+        EXPECT_EQ(p.finding[i], StationFinding::wet_to_ground_end);
+        EXPECT_TRUE(std::isnan(p.excess_m[i]));
+        EXPECT_NEAR(p.at_least_m[i], 1.995, 1e-9);  // the last probe on the ground
+    }
+    const Measured m = excess("drive_out_excess", p);
+    for (const char* name : {"drive_out_excess_mean_m", "drive_out_excess_sd_m", "drive_out_excess_min_m", "drive_out_excess_max_m"}) {
+        EXPECT_EQ(m.values.count(name), 0u) << name;
+        EXPECT_EQ(m.not_measured.at(name),
+                  "wet to the end of the judged ground (judge.ground) at 5 of 5 stations: the wet edge lies beyond it, "
+                  "at least 1.995 m past the boundary (+ outside); a larger ground would measure it")
+            << name;
+    }
+    EXPECT_EQ(m.values.at("drive_out_excess_stations"), 0.0);
+    EXPECT_EQ(m.values.at("drive_out_excess_stations_dry"), 0.0);
+    // Some stations measured, some beyond: no mean or max, but the smallest
+    // measured excess (0.1 m, below every "at least") is the minimum.
+    const Measured mixed =
+        excess("drive_out_excess", wet_edge_profile(raster_where([](double e, double n) { return e < 0.25 || n < 0.1; }),
+                                                            kNorthEdge));
+    EXPECT_NEAR(mixed.values.at("drive_out_excess_min_m"), 0.1, 0.005);
+    EXPECT_EQ(mixed.values.at("drive_out_excess_stations"), 2.0);  // stations at east 1.0 and 0.5
+    EXPECT_EQ(mixed.not_measured.count("drive_out_excess_mean_m"), 1u);
+    EXPECT_EQ(mixed.not_measured.count("drive_out_excess_max_m"), 1u);
+    // Per nozzle alike.
+    const Measured pn = per_nozzle_excess("drive_out_excess", {p});
+    EXPECT_EQ(pn.values.count("drive_out_excess_nozzle0_mean_m"), 0u);
+    EXPECT_EQ(pn.not_measured.count("drive_out_excess_nozzle0_mean_m"), 1u);
+    EXPECT_EQ(pn.not_measured.count("drive_out_excess_nozzle0_max_m"), 1u);
+}
+
+TEST(BoundaryMetrics, AStationWhoseProbeMissesTheGroundIsNotADryOne) {
+    // An edge along north = 0 from east 10 to 8: its probes run north-south at
+    // east 8-10, off the ground (east -2 ... 2).
+    const EdgeProfile p = wet_edge_profile(raster_where([](double, double) { return true; }), BoundaryEdge{10.0, 0.0, 8.0, 0.0});
+    ASSERT_EQ(p.finding.size(), 5u);
+    for (const StationFinding finding : p.finding) EXPECT_EQ(finding, StationFinding::off_ground);
+    const Measured m = excess("boundary_overrun", p);
+    EXPECT_EQ(m.values.at("boundary_overrun_stations_dry"), 0.0);
+    EXPECT_EQ(m.not_measured.at("boundary_overrun_mean_m"),
+              "5 of 5 stations probe off the judged ground (judge.ground does not reach them)");
 }
 
 TEST(BoundaryMetrics, BadInputIsRejected) {
@@ -161,7 +261,8 @@ const rig::field2d::Polygon kSquare({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, "squar
 
 TEST(CentreRuleMetrics, AllOffWithTheCentreOutsideScoresZero) {
     // The centre 0.2 m outside all along, nothing delivered: the start counts as one spell.
-    const auto m = centre_rule_metrics(along_east_edge([](double) { return 0.2; }, 0.0, 8.0, [](double) { return false; }), kSquare);
+    const auto m =
+        centre_rule(along_east_edge([](double) { return 0.2; }, 0.0, 8.0, [](double) { return false; }), kSquare).values;
     EXPECT_EQ(m.at("centre_out_crossings"), 1.0);
     EXPECT_EQ(m.at("centre_out_samples"), 81.0);
     EXPECT_EQ(m.at("centre_out_spray_ml"), 0.0);
@@ -169,21 +270,33 @@ TEST(CentreRuleMetrics, AllOffWithTheCentreOutsideScoresZero) {
     EXPECT_EQ(m.at("centre_out_close_m"), 0.0);
 }
 
+TEST(CentreRuleMetrics, ACentreThatNeverLeftTheAreaLeavesTheClosingNotMeasured) {
+    // Inside all along (east 9.8), spraying: nothing to close, and no 0 s passed off as a rule obeyed.
+    const Measured m =
+        centre_rule(along_east_edge([](double) { return -0.2; }, 0.0, 4.0, [](double) { return true; }), kSquare);
+    EXPECT_EQ(m.values.at("centre_out_crossings"), 0.0);
+    EXPECT_EQ(m.values.at("centre_out_spray_ml"), 0.0);
+    for (const char* name : {"centre_out_close_s", "centre_out_close_m"}) {
+        EXPECT_EQ(m.values.count(name), 0u) << name;
+        EXPECT_EQ(m.not_measured.at(name), "the boom centre never left the target area: the rule was never put to the test");
+    }
+}
+
 TEST(CentreRuleMetrics, ClosingLateAfterTheCentreCrossesOutIsMeasuredFromTheCrossing) {
     // Inside (east 9.8) until t = 3, outside (10.2) after; the spray stops at
     // t = 3.3 (last delivering sample 3.3): 0.3 s, the centre's travel 0.3 m
     // along plus nothing across (it jumped out between samples), 3 samples x 1 mL.
-    const auto m = centre_rule_metrics(
+    const auto m = centre_rule(
         along_east_edge([](double t) { return t < 3.0 - 1e-9 ? -0.2 : 0.2; }, 0.0, 6.0, [](double t) { return t < 3.35; }),
-        kSquare);
+        kSquare).values;
     EXPECT_EQ(m.at("centre_out_crossings"), 1.0);
     EXPECT_NEAR(m.at("centre_out_close_s"), 0.3, 1e-9);
     EXPECT_NEAR(m.at("centre_out_close_m"), 0.3, 1e-9);
     EXPECT_NEAR(m.at("centre_out_spray_ml"), 4.0, 1e-9);  // t = 3.0, 3.1, 3.2, 3.3
     // A controller that ignores the rule sprays all the way: the longest spell's 3 s.
-    const auto ignored = centre_rule_metrics(
+    const auto ignored = centre_rule(
         along_east_edge([](double t) { return t < 3.0 - 1e-9 ? -0.2 : 0.2; }, 0.0, 6.0, [](double) { return true; }),
-        kSquare);
+        kSquare).values;
     EXPECT_NEAR(ignored.at("centre_out_close_s"), 3.0, 1e-9);
     EXPECT_NEAR(ignored.at("centre_out_spray_ml"), 31.0, 1e-9);
 }
@@ -192,20 +305,20 @@ TEST(CentreRuleMetrics, TheLongestOfSeveralSpellsCountsAndBadInputIsNamed) {
     // Out 1-2 s (spray until 1.2), in, out 4-6 s (spray until 4.5).
     const auto out = [](double t) { return (t > 0.95 && t < 2.05) || t > 3.95 ? 0.2 : -0.2; };
     const auto open = [](double t) { return t < 1.25 || (t > 2.5 && t < 4.55); };
-    const auto m = centre_rule_metrics(along_east_edge(out, 0.0, 6.0, open), kSquare);
+    const auto m = centre_rule(along_east_edge(out, 0.0, 6.0, open), kSquare).values;
     EXPECT_EQ(m.at("centre_out_crossings"), 2.0);
     EXPECT_NEAR(m.at("centre_out_close_s"), 0.5, 1e-9);
     std::vector<CentreRuleSample> bad = along_east_edge(out, 0.0, 1.0, open);
     bad[3].volume_l = -1.0;
     try {
-        centre_rule_metrics(bad, kSquare);
+        centre_rule(bad, kSquare);
         FAIL() << "a negative volume passed";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("sample 3"), std::string::npos) << e.what();
     }
     bad[3].volume_l = 0.0;
     bad[5].t_s = 0.1;
-    EXPECT_THROW(centre_rule_metrics(bad, kSquare), std::invalid_argument);
+    EXPECT_THROW(centre_rule(bad, kSquare), std::invalid_argument);
 }
 
 TEST(FlowMetrics, DeliveredAgainstTable3) {

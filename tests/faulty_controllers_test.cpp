@@ -101,6 +101,7 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
         {"stops-answering", "node_unresponsive"},
         {"reads-truth-topic", "topic_role_violation"},
         {"forges-truth-topic", "topic_role_violation"},
+        {"wrong-section-count", "malformed_command"},
     };
     ASSERT_EQ(results.at("cases").size(), broken.size() + errors.size() + 4) << results.dump(2);
     for (const auto& [name, metrics] : broken) {
@@ -143,9 +144,31 @@ TEST(FaultyControllers, EachFailsOnItsNamedMetricOrErrorAndTheControlsPass) {
     // Role violations name the topic and the participant.
     const std::string reader_error = find_case(results, "reads-truth-topic-seed1")->at("error").get<std::string>();
     EXPECT_NE(reader_error.find("node 'controller': reads truth topic truth/vehicle"), std::string::npos) << reader_error;
+    // Its hello hides the reader: only discovery can tell it, and says so on every run.
+    EXPECT_NE(reader_error.find(", seen by discovery)"), std::string::npos) << reader_error;
     const std::string forger_error = find_case(results, "forges-truth-topic-seed1")->at("error").get<std::string>();
     EXPECT_NE(forger_error.find("node 'controller': writes truth topic truth/hydraulics"), std::string::npos)
         << forger_error;
+
+    // The section command for a fourth section fails the case at the instant it
+    // was sent, named; the trace keeps it as the last section command.
+    const std::string malformed_error = find_case(results, "wrong-section-count-seed1")->at("error").get<std::string>();
+    const std::regex malformed_text(
+        R"(node 'controller': actuator/section_valves/open at t=([0-9]+\.[0-9]{3}) s: )"
+        R"(open_mask 15 sets bit 3, but the boom has 3 sections \(bits 0-2\))");
+    std::smatch malformed_at;
+    ASSERT_TRUE(std::regex_search(malformed_error, malformed_at, malformed_text)) << malformed_error;
+    const fs::path malformed_trace = out / "run" / "cases" / "wrong-section-count-seed1" / "trace.sqlite";
+    const std::string last_sections = read_all_command(
+        "sqlite3 '" + malformed_trace.string() +
+        "' \"select t_ns, json from samples where topic = 'actuator/section_valves/open' order by t_ns desc, round desc limit 1\"");
+    const auto last_bar = last_sections.find('|');
+    ASSERT_NE(last_bar, std::string::npos) << last_sections;
+    EXPECT_NEAR(static_cast<double>(std::stoll(last_sections.substr(0, last_bar))) / 1e9, std::stod(malformed_at[1]), 0.0005)
+        << last_sections;
+    EXPECT_NE(last_sections.find(R"("open_mask":15)"), std::string::npos) << last_sections;
+    // When the first pass starts spraying (10.64 s on seed 1, after the 10 s wait), not at t = 0.
+    EXPECT_GT(std::stod(malformed_at[1]), 5.0) << malformed_error;
 
     // The crashed controller's trace keeps every sample up to the crash (20 s), and says why it ends.
     const fs::path crashed = out / "run" / "cases" / "crashes-mid-case-seed1" / "trace.sqlite";
@@ -208,9 +231,11 @@ TEST(FaultyControllers, ANoCompensationControllerWithoutItsExpectationFailsTheRu
 }
 
 // A controller that declares a truth topic in its hello fails when the hellos
-// arrive at the latest, before time starts: on every run with no instant run, so the same trace
-// (when discovery told it, the trace held 0 or 13 samples of the first instant
-// depending on when the announcement arrived).
+// are checked, before time starts: on every run with no instant run, so the
+// same trace (when discovery told it, the trace held 0 or 13 samples of the
+// first instant depending on when the announcement arrived), and with the same
+// reason: what discovery saw during start-up waits for the hello check (it
+// once spoke first in about 1 run of 5).
 TEST(FaultyControllers, ADeclaredForgedTopicFailsBeforeTimeStartsWithTheSameTraceEveryRun) {
     const fs::path out = fresh_dir("declared-forgery");
     std::string digest;
@@ -219,9 +244,8 @@ TEST(FaultyControllers, ADeclaredForgedTopicFailsBeforeTimeStartsWithTheSameTrac
         const int status = rig_run(kCatalogue / "forges-truth-topic.yaml", dir, out / "rig.log", "--seed 2");
         ASSERT_EQ(status, 0) << read_all(out / "rig.log");
         const nlohmann::json only = load_results(dir).at("cases").at(0);
-        // Discovery may still tell it first, while the rig waits for the hellos:
-        // before time starts too.
-        EXPECT_NE(only.at("error").get<std::string>().find("writes truth topic truth/hydraulics"), std::string::npos)
+        EXPECT_EQ(only.at("error").get<std::string>(),
+                  "node 'controller': writes truth topic truth/hydraulics (declared in its hello)")
             << only.dump(2);
         EXPECT_EQ(only.at("rounds"), 0) << only.dump(2);
         if (run == 0) digest = only.at("trace_sha256").get<std::string>();

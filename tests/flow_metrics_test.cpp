@@ -5,10 +5,12 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <cstdint>
 #include <vector>
 
+#include "emulators/field_frame.h"
 #include "harness/systems/breakpoint/breakpoint_metrics.h"
 
 namespace {
@@ -397,9 +399,61 @@ TEST(DepositionMetrics, NeverSprayingMissesTheWholeStrip) {
     const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
     EXPECT_NEAR(at(result.metrics.values, "missed_m"), 16.0, 1e-9);
     EXPECT_EQ(at(result.metrics.values, "overlap_m"), 0.0);
-    // A strip reaching past the recorded grid: rows outside it were not sprayed either.
-    EXPECT_NEAR(at(rig::harness::deposition_metrics(p, judging(-12.0, 12.0), 0.0).metrics.values, "missed_m"), 24.0,
-                0.05 + 1e-9);
+    // A strip reaching past the recorded ground (-10 to +10 m): the rows out
+    // there are unknown ground, neither sprayed nor missed. It used to count
+    // them missed (24 m): a number the ground's extent made, not the controller.
+    const MetricSet beyond = rig::harness::deposition_metrics(p, judging(-12.0, 12.0), 0.0).metrics;
+    EXPECT_EQ(beyond.values.count("missed_m"), 0u);
+    const std::string why = beyond.not_measured.at("missed_m");
+    EXPECT_NE(why.find("rows of the strip that must be sprayed (-12.00 to 12.00 m along) lie off the ground: "
+                       "the recorded ground spans -10.00 to 10.00 m"),
+              std::string::npos)
+        << why;
+}
+
+TEST(DepositionMetrics, GroundWithNoPassLaidOnItIsMissedNotUnknown) {
+    // A controller that never sprayed leaves no pass layer (the trace's grid
+    // has 0 passes), but the ground was there: the whole strip is missed.
+    DoseProfile p;
+    p.first_row_centre_m = -9.975;
+    p.row_m = 0.05;
+    p.ground_rows = 400;
+    const auto result = rig::harness::deposition_metrics(p, judging(), 0.0);
+    EXPECT_NEAR(at(result.metrics.values, "missed_m"), 16.0, 1e-9);
+    // Without the ground's rows the strip lies on no recorded ground at all.
+    p.ground_rows = 0;
+    EXPECT_EQ(rig::harness::deposition_metrics(p, judging(), 0.0).metrics.not_measured.count("missed_m"), 1u);
+}
+
+// ---------------------------------------------------------------- where the nozzle line was
+
+TEST(VehicleTrack, NoPositionOutsideTheRecordedTruth) {
+    // Truth from 1 s to 2 s, the nozzle line moving 1 m/s from 10 m.
+    const rig::harness::VehicleTrack track({{1 * kS, 10.0, 0}, {2 * kS, 11.0, 0}});
+    EXPECT_DOUBLE_EQ(*track.nozzle_line_along_m(1500 * kMs), 10.5);
+    EXPECT_DOUBLE_EQ(*track.nozzle_line_along_m(2 * kS), 11.0);
+    // Before the first sample or after the last, truth does not say: never the
+    // nearest sample held as if the vehicle stood there.
+    EXPECT_FALSE(track.nozzle_line_along_m(999 * kMs).has_value());
+    EXPECT_FALSE(track.nozzle_line_along_m(2001 * kMs).has_value());
+    EXPECT_EQ(track.describe_span(), "the vehicle truth recorded spans 1.000 s to 2.000 s");
+}
+
+TEST(BreakpointMetrics, ADeclarationOutsideTheRecordedTruthIsNotMeasured) {
+    const rig::harness::VehicleTrack track({{1 * kS, 10.0, 0}, {2 * kS, 11.0, 0}});
+    const rig::emulators::FieldFrame field(40.18, 116.44, 50.0, 90.0);
+    // Declared at 1.5 s: 0.5 m past the breakpoint at 10 m.
+    const MetricSet on_track =
+        rig::harness::breakpoint_metrics({{1500 * kMs, "reached", std::nullopt, std::nullopt}}, track, field, 10.0);
+    EXPECT_DOUBLE_EQ(at(on_track, "breakpoint_error_m"), 0.5);
+    // Declared at 3 s, after the last truth sample: where the nozzle line was is unknown.
+    const MetricSet after =
+        rig::harness::breakpoint_metrics({{3 * kS, "reached", std::nullopt, std::nullopt}}, track, field, 10.0);
+    EXPECT_EQ(after.values.count("breakpoint_error_m"), 0u);
+    EXPECT_EQ(after.values.at("breakpoint_reached_count"), 1.0);
+    EXPECT_EQ(after.not_measured.at("breakpoint_error_m"),
+              "declared at 3.000 s, where truth has no position of the nozzle line: the vehicle truth recorded spans "
+              "1.000 s to 2.000 s");
 }
 
 TEST(DepositionMetrics, RowBelowHalfTheNominalDoseCountsAsUnsprayed) {

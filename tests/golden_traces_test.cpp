@@ -41,6 +41,13 @@ fs::path unpacked_run(const std::string& name) {
     return run;
 }
 
+// The output's last line, without its newline.
+std::string last_line(const std::string& output) {
+    std::string text = output;
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    return text.substr(text.rfind('\n') + 1);
+}
+
 nlohmann::json read_json(const fs::path& file) {
     std::ifstream in(file);
     return nlohmann::json::parse(in);
@@ -92,9 +99,42 @@ TEST(GoldenTraces, ANumberJudgedDifferentlyFailsTheCheckNamingIt) {
     }
     std::ofstream(run / "results.json") << results.dump(1);
     const auto judged = run_shell(kRig + " judge " + quoted(run) + " --check 2>&1");
-    EXPECT_EQ(judged.exit_code, 1) << judged.output;
+    // Its own exit status: the judging changed, not the controller (every case passed).
+    EXPECT_EQ(judged.exit_code, 5) << judged.output;
     EXPECT_NE(judged.output.find("overlap_m"), std::string::npos) << judged.output;
     EXPECT_NE(judged.output.find(changed->at("name").get<std::string>()), std::string::npos) << judged.output;
+    EXPECT_EQ(last_line(judged.output),
+              "re-judged: 1 difference(s) from the results recorded: the judging changed, whatever the verdicts (exit status 5)");
+}
+
+// A case that failed, re-judged as it was recorded: exit status 1 as `rig run`,
+// told apart from a changed judging (5) on the last line.
+TEST(GoldenTraces, AFailureJudgedAsRecordedExitsOneAndADifferenceFiveWhateverTheVerdicts) {
+    const fs::path run = unpacked_run("golden-traces-failed");
+    // The run's plan (meta, outside the digest) gets an overlap limit of 0 m, which the repeated strip breaks.
+    const fs::path trace = run / "cases" / "golden-breakpoint-continuation" / "trace.sqlite";
+    const auto tightened = run_shell("sqlite3 " + quoted(trace) +
+                                     " \"update meta set value = json_set(value, '$.limits.overlap_m', 0.0) where key = 'judging'\" 2>&1");
+    ASSERT_EQ(tightened.exit_code, 0) << tightened.output;
+    // What a run with that plan records.
+    const auto recorded = run_shell(kRig + " judge " + quoted(run) + " --out " + quoted(run.parent_path() / "recorded") + " 2>&1");
+    ASSERT_EQ(recorded.exit_code, 1) << recorded.output;
+    fs::copy_file(run.parent_path() / "recorded" / "results.json", run / "results.json", fs::copy_options::overwrite_existing);
+
+    const auto same = run_shell(kRig + " judge " + quoted(run) + " --check 2>&1");
+    EXPECT_EQ(same.exit_code, 1) << same.output;
+    EXPECT_EQ(last_line(same.output),
+              "re-judged: every metric, verdict and digest as recorded; 1 case(s) failed, as recorded (exit status 1)");
+
+    // The same failed run with one number recorded differently: 5, the failure notwithstanding.
+    nlohmann::json results = read_json(run / "results.json");
+    for (nlohmann::json& one : results.at("cases")) {
+        if (one.at("name") == "golden-breakpoint-continuation") one["metrics"]["overlap_m"] = 99.0;
+    }
+    std::ofstream(run / "results.json") << results.dump(1);
+    const auto differing = run_shell(kRig + " judge " + quoted(run) + " --check 2>&1");
+    EXPECT_EQ(differing.exit_code, 5) << differing.output;
+    EXPECT_NE(last_line(differing.output).find("(exit status 5)"), std::string::npos) << differing.output;
 }
 
 }  // namespace

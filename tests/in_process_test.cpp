@@ -77,6 +77,28 @@ TEST(InProcess, AForgedTruthTopicIsCaughtInProcessToo) {
     EXPECT_EQ(result.value("error_kind", ""), "topic_role_violation") << run.output;
 }
 
+// A malformed actuator command (issue 29) ends the case the same way whether
+// the controller is a process or a plugin: same error, same instant, same trace.
+TEST(InProcess, AMalformedCommandFailsTheCaseAsInProcessMode) {
+    const std::filesystem::path dir = fresh_dir("in_process_malformed");
+    const std::string case_file = (kCases / "faulty-controllers" / "wrong-section-count.yaml").string() + " --seed 1";
+    const RunResult process = rig_run(case_file, dir / "process");
+    const RunResult in_process = rig_run(case_file + " --in-process", dir / "in-process");
+    ASSERT_EQ(process.exit_code, 0) << process.output;  // the expected failure happened: the case passes
+    ASSERT_EQ(in_process.exit_code, 0) << in_process.output;
+    const nlohmann::json& a = only_case(process);
+    const nlohmann::json& b = only_case(in_process);
+    EXPECT_EQ(b.value("controller_mode", ""), "in_process");
+    EXPECT_EQ(a.value("error_kind", ""), "malformed_command") << a.dump(2);
+    EXPECT_EQ(b.value("error_kind", ""), "malformed_command") << b.dump(2);
+    const auto first_line = [](const std::string& message) { return message.substr(0, message.find('\n')); };
+    const std::string error = first_line(b.value("error", ""));
+    EXPECT_NE(error.find("node 'controller': actuator/section_valves/open at t="), std::string::npos) << error;
+    EXPECT_EQ(first_line(a.value("error", "")), error);
+    ASSERT_FALSE(a.value("trace_sha256", "").empty());
+    EXPECT_EQ(a.value("trace_sha256", ""), b.value("trace_sha256", "")) << "the in-process trace differs";
+}
+
 TEST(InProcess, AFaultThatWouldKillTheRigRunsAsAProcessAndSaysWhy) {
     const std::filesystem::path dir = fresh_dir("in_process_refused");
     const RunResult run = rig_run((kCases / "faulty-controllers" / "crashes-mid-case.yaml").string() + " --seed 1 --in-process", dir);

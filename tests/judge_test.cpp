@@ -340,14 +340,15 @@ TEST(Judge, AnOverloadedRigMakesTheRunInvalidNotTheControllersFailure) {
 }
 
 // What the overload wins over, and what it does not: an error the controller
-// caused is kept in the text; a stop signal, the rig's own error and a broken
-// topic role are not the lateness's doing and stay as they are.
+// caused is kept in the text; a stop signal, the rig's own error, a broken
+// topic role and a malformed command are not the lateness's doing and stay as
+// they are.
 TEST(Judge, TheOverloadWinsOverTheControllersErrorsButNotTheRigsOwn) {
     const std::string overloaded = "plant emitted 300.0 ms after its deadline at t = 10.000 s";
     const std::vector<std::pair<std::string, std::string>> ends = {
         {"node_exited", "rig_overloaded"},      {"board_silent", "rig_overloaded"},
         {"interrupted", "interrupted"},         {"harness_error", "harness_error"},
-        {"topic_role_violation", "topic_role_violation"}};
+        {"topic_role_violation", "topic_role_violation"}, {"malformed_command", "malformed_command"}};
     for (const auto& [ended, judged] : ends) {
         SCOPED_TRACE(ended);
         HandMadeTrace made("overloaded-" + ended, continuation_plan());

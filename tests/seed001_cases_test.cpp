@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <string>
 
@@ -87,6 +88,73 @@ TEST(Seed001Cases, ReferencePassesFaultyFailsOnItsMetricAndTheJudgeAgrees) {
     EXPECT_EQ(rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",
                   out / "judge.log"),
               0)
+        << rig::testing::read_all(out / "judge.log");
+}
+
+// Issue 29: a duty message with 7 entries for 6 nozzles fails the case as
+// malformed_command, naming the topic, the instant it was sent and what was
+// wrong; the trace keeps the command. The shipped case expects it (and
+// passes); the same case without its expectation fails, and results.json,
+// junit.xml and report.txt say why.
+TEST(Seed001Cases, ADutyMessageWithAnExtraEntryFailsTheCaseNamingTopicInstantAndCount) {
+    const fs::path out = fresh_dir("malformed");
+    const fs::path shipped = kCases / "seed001-faulty-controllers" / "extra-duty-entry.yaml";
+    std::string text = rig::testing::read_all(shipped);
+    const std::string name_line = "name: seed001-faulty-extra-duty-entry";
+    const std::string expect_line = "expect: { error: malformed_command }";
+    ASSERT_NE(text.find(name_line), std::string::npos) << text;
+    ASSERT_NE(text.find(expect_line), std::string::npos) << text;
+    text.replace(text.find(name_line), name_line.size(), "name: extra-duty-entry-unexpected");
+    text.erase(text.find(expect_line), expect_line.size());
+    std::ofstream(out / "unexpected.yaml") << text;
+    const int status = rig("run '" + shipped.string() + "' '" + (out / "unexpected.yaml").string() +
+                               "' --jobs 2 --out '" + (out / "run").string() + "'",
+                           out / "run.log");
+    EXPECT_EQ(status, 1) << "the unexpected one fails the run:\n" << rig::testing::read_all(out / "run.log");
+    const nlohmann::json results = load_results(out / "run");
+
+    const nlohmann::json& expected = find_case(results, "seed001-faulty-extra-duty-entry");
+    EXPECT_TRUE(expected.at("passed").get<bool>()) << expected.dump(2);
+    EXPECT_EQ(expected.at("error_kind"), "malformed_command") << expected.dump(2);
+    const std::string error = expected.at("error").get<std::string>();
+    const std::regex named(R"(^node 'controller': actuator/nozzle_pwm/duty at t=([0-9]+\.[0-9]{3}) s: 7 duty entries for 6 nozzles)");
+    std::smatch at;
+    ASSERT_TRUE(std::regex_search(error, at, named)) << error;
+    // The command that turned the nozzles on at the north edge (5 s in), kept as the trace's last duty message.
+    const fs::path trace = out / "run" / "cases" / "seed001-faulty-extra-duty-entry" / "trace.sqlite";
+    const std::string last = rig::testing::read_all_command(
+        "sqlite3 '" + trace.string() +
+        "' \"select t_ns, json_array_length(json, '$.duty_pct') from samples where topic = 'actuator/nozzle_pwm/duty' "
+        "order by t_ns desc, round desc limit 1\"");
+    const auto bar = last.find('|');
+    ASSERT_NE(bar, std::string::npos) << last;
+    EXPECT_NEAR(static_cast<double>(std::stoll(last.substr(0, bar))) / 1e9, std::stod(at[1]), 0.0005) << last;
+    EXPECT_EQ(std::stoi(last.substr(bar + 1)), 7) << last;
+    EXPECT_GT(std::stod(at[1]), 3.0) << error;
+
+    const nlohmann::json& unexpected = find_case(results, "extra-duty-entry-unexpected");
+    EXPECT_FALSE(unexpected.at("passed").get<bool>()) << unexpected.dump(2);
+    EXPECT_EQ(unexpected.at("verdict"), "failed");
+    EXPECT_EQ(unexpected.at("error_kind"), "malformed_command");
+    // Same seed, same command at the same instant (the error's first line; the controller's log follows it).
+    const auto first_line = [](const std::string& message) { return message.substr(0, message.find('\n')); };
+    EXPECT_EQ(first_line(unexpected.at("error").get<std::string>()), first_line(error));
+    const std::string junit = rig::testing::read_all(out / "run" / "junit.xml");
+    EXPECT_NE(junit.find("<error type=\"malformed_command\" message=\"node &apos;controller&apos;: "
+                         "actuator/nozzle_pwm/duty at t="),
+              std::string::npos)
+        << junit;
+    const std::string report = rig::testing::read_all(out / "run" / "report.txt");
+    EXPECT_NE(report.find("error (malformed_command): node 'controller': actuator/nozzle_pwm/duty at t="), std::string::npos)
+        << report;
+
+    // `rig judge` gives the same verdicts from the traces alone.
+    EXPECT_EQ(rig("judge '" + (out / "run").string() + "' --check --out '" + (out / "rejudged").string() + "'",
+                  out / "judge.log"),
+              1)
+        << rig::testing::read_all(out / "judge.log");
+    EXPECT_NE(rig::testing::read_all(out / "judge.log").find("re-judged: every metric, verdict and digest as recorded"),
+              std::string::npos)
         << rig::testing::read_all(out / "judge.log");
 }
 

@@ -2,6 +2,8 @@
 // every case lands in exactly one shard, by its name alone; the shards of a
 // suite, merged, are the suite run at once: the same cases with the same trace
 // digests, metrics and verdicts; merges that cannot be right are refused.
+// `rig sweep --shard I/N` deals the sweep's runs out in turn, and its shards,
+// merged, are the sweep run at once (harness/report/sweep_shard.h).
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -9,8 +11,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "harness/run/shard.h"
 #include "run_support.h"
@@ -19,6 +23,7 @@
 namespace fs = std::filesystem;
 using rig::harness::parse_shard;
 using rig::harness::shard_of;
+using rig::harness::shard_of_run;
 using rig::testing::fresh_dir;
 using rig::testing::read_all;
 using rig::testing::run_shell;
@@ -34,6 +39,41 @@ std::map<std::string, nlohmann::json> cases_by_name(const fs::path& out) {
     const nlohmann::json results = nlohmann::json::parse(text);
     for (const nlohmann::json& one : results.at("cases")) cases[one.at("name").get<std::string>()] = one;
     return cases;
+}
+
+const std::string kRig = quoted(RIG_BINARY_DIR "/bin/rig");
+
+// Every file under `dir`, relative to it.
+std::set<std::string> files_under(const fs::path& dir) {
+    std::set<std::string> files;
+    if (!fs::is_directory(dir)) return files;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+        if (entry.is_regular_file()) files.insert(fs::relative(entry.path(), dir).string());
+    }
+    return files;
+}
+
+// A sweep's text without what only the wall clock gives: the wall time and the start.
+std::string without_wall_clock(const std::string& text) {
+    const std::string no_wall = std::regex_replace(text, std::regex(R"(in \S+ s wall)"), "in (wall) s wall");
+    return std::regex_replace(no_wall, std::regex(R"(started [0-9T:-]+)"), "started (when)");
+}
+
+nlohmann::json sweep_json_of(const fs::path& out) {
+    const std::string text = read_all(out / "sweep.json");
+    return text.empty() ? nlohmann::json() : nlohmann::json::parse(text);
+}
+
+// Two short lockstep cases: short-fusion, and a copy with a tight limit (some
+// seeds fail and keep their traces) and paper numbers (one the rig does not measure).
+std::string two_short_cases(const fs::path& dir) {
+    std::string tight = read_all(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    tight = std::regex_replace(tight, std::regex("name: short-fusion"), "name: short-fusion-tight");
+    tight = std::regex_replace(tight, std::regex(R"(limits: \{ breakpoint_error_m: [0-9.]+ \})"),
+                               "limits: { breakpoint_error_m: 0.005 }");
+    tight += "paper: { source: \"a test's own numbers\", breakpoint_error_m: 0.004, spray_delay_s: 0.2 }\n";
+    std::ofstream(dir / "tight.yaml") << tight;
+    return quoted(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml") + " " + quoted(dir / "tight.yaml");
 }
 
 }  // namespace
@@ -120,6 +160,23 @@ TEST(ShardAndMerge, TheMergedShardsAreTheSuiteRunAtOnce) {
     const auto schema = run_shell("xmllint --noout --schema " + quoted(RIG_SOURCE_DIR "/tests/data/jenkins-junit-10.xsd") +
                                   " " + quoted(dir / "merged" / "junit.xml") + " 2>&1");
     EXPECT_EQ(schema.exit_code, 0) << schema.output;
+
+    // A shard whose recorded number its trace does not give: exit status 5
+    // (the judging or the shard changed, not the controller), said last.
+    nlohmann::json shard_results = nlohmann::json::parse(read_all(dir / "shard-2" / "results.json"));
+    nlohmann::json& changed = shard_results.at("cases").at(0);
+    ASSERT_FALSE(changed.at("metrics").empty()) << changed.dump(2);
+    changed.at("metrics").begin().value() = 1e9;
+    std::ofstream(dir / "shard-2" / "results.json") << shard_results.dump(1);
+    const auto differing = run_shell(rig + " merge " + quoted(dir / "shard-1") + " " + quoted(dir / "shard-2") +
+                                     " --out " + quoted(dir / "merged-differing") + " 2>&1");
+    EXPECT_EQ(differing.exit_code, 5) << differing.output;
+    EXPECT_NE(differing.output.find("differs: " + changed.at("name").get<std::string>()), std::string::npos)
+        << differing.output;
+    EXPECT_NE(differing.output.find("difference(s) from the results the shards recorded: the judging changed, whatever "
+                                    "the verdicts (exit status 5)\n"),
+              std::string::npos)
+        << differing.output;
 }
 
 TEST(ShardAndMerge, MergesThatCannotBeRightAreRefusedBeforeWriting) {
@@ -154,4 +211,135 @@ TEST(ShardAndMerge, MergesThatCannotBeRightAreRefusedBeforeWriting) {
     EXPECT_EQ(bad.exit_code, 2) << bad.output;
     EXPECT_NE(bad.output.find("--shard '3/2': needs 1 <= I <= N <= 1000"), std::string::npos) << bad.output;
     EXPECT_FALSE(fs::exists(dir / "b" / "results.json"));
+}
+
+TEST(SweepShard, RunsAreDealtInTurnSoShardsDifferByOneRunAtMost) {
+    // 3 cases over 7 seeds, run k being case k / 7's seed k % 7.
+    for (const int count : {1, 2, 4, 5, 30}) {
+        std::map<int, int> per_shard;
+        std::map<std::pair<int, int>, int> per_case_and_shard;
+        for (std::size_t k = 0; k < 21; ++k) {
+            const int shard = shard_of_run(k, count);
+            ASSERT_GE(shard, 1);
+            ASSERT_LE(shard, count);
+            ++per_shard[shard];
+            ++per_case_and_shard[{static_cast<int>(k / 7), shard}];
+        }
+        int least = 21, most = 0;
+        for (int shard = 1; shard <= count; ++shard) {
+            least = std::min(least, per_shard[shard]);
+            most = std::max(most, per_shard[shard]);
+        }
+        EXPECT_LE(most - least, 1) << count << " shards";
+        // Each case's seeds spread over the shards too (its runs are alike in length).
+        for (const auto& [case_and_shard, runs] : per_case_and_shard) EXPECT_LE(runs, (7 + count - 1) / count);
+    }
+}
+
+// A sweep in two shards, merged, is the sweep run at once: sweep.json but for
+// its wall-clock fields, sweep.txt and sweep.html but for the wall time, and
+// the runs' kept files.
+TEST(SweepShard, TheMergedShardsAreTheSweepRunAtOnce) {
+    const fs::path dir = fresh_dir("sweep-shard-merge");
+    const std::string cases = two_short_cases(dir);
+    const std::string sweep = kRig + " sweep " + cases + " --seeds 5 --first-seed 3 --in-process";
+    const auto all = run_shell(sweep + " --out " + quoted(dir / "all") + " 2>&1");
+    const nlohmann::json whole = sweep_json_of(dir / "all");
+    ASSERT_TRUE(whole.is_object()) << all.output;
+    // What the test stands on: runs that passed and runs that did not (and kept their traces).
+    const nlohmann::json& tight = whole.at("cases").at(1);
+    ASSERT_EQ(tight.at("name"), "short-fusion-tight");
+    ASSERT_GT(tight.at("passed").get<int>(), 0) << all.output;
+    ASSERT_LT(tight.at("passed").get<int>(), 5) << all.output;
+    EXPECT_EQ(all.exit_code, 1) << all.output;
+    EXPECT_EQ(tight.at("paper_unmatched"), nlohmann::json::array({"spray_delay_s"}));
+
+    std::vector<nlohmann::json> shards;
+    for (const char* shard : {"1/2", "2/2"}) {
+        const fs::path out = dir / (std::string("shard-") + shard[0]);
+        const auto run = run_shell(sweep + " --shard " + shard + " --out " + quoted(out) + " 2>&1");
+        EXPECT_NE(run.output.find(std::string("rig sweep: shard ") + shard + ": 5 of 10 runs"), std::string::npos)
+            << run.output;
+        shards.push_back(sweep_json_of(out));
+        ASSERT_TRUE(shards.back().is_object()) << run.output;
+        EXPECT_EQ(shards.back().at("shard").at("runs").size(), 5u);
+        EXPECT_EQ(shards.back().at("seeds"), whole.at("seeds"));  // the whole sweep's seeds, whatever the shard holds
+    }
+    const auto merged = run_shell(kRig + " merge " + quoted(dir / "shard-1") + " " + quoted(dir / "shard-2") +
+                                  " --out " + quoted(dir / "merged") + " 2>&1");
+    EXPECT_EQ(merged.exit_code, all.exit_code) << merged.output;
+    EXPECT_NE(merged.output.find("merged 10 runs from 2 shards"), std::string::npos) << merged.output;
+
+    nlohmann::json joined = sweep_json_of(dir / "merged");
+    ASSERT_TRUE(joined.is_object()) << merged.output;
+    // The wall-clock fields: the earliest start, the machine time summed.
+    EXPECT_EQ(joined.at("started_utc"),
+              std::min(shards[0].at("started_utc").get<std::string>(), shards[1].at("started_utc").get<std::string>()));
+    EXPECT_EQ(joined.at("wall_seconds").get<double>(),
+              shards[0].at("wall_seconds").get<double>() + shards[1].at("wall_seconds").get<double>());
+    nlohmann::json at_once = whole;
+    for (nlohmann::json* json : {&at_once, &joined}) {
+        json->erase("started_utc");
+        json->erase("wall_seconds");
+    }
+    EXPECT_EQ(joined, at_once) << "merged:\n" << joined.dump(1) << "\nat once:\n" << at_once.dump(1);
+    EXPECT_FALSE(joined.contains("shard"));
+    EXPECT_EQ(without_wall_clock(read_all(dir / "merged" / "sweep.txt")), without_wall_clock(read_all(dir / "all" / "sweep.txt")));
+    EXPECT_EQ(without_wall_clock(read_all(dir / "merged" / "sweep.html")),
+              without_wall_clock(read_all(dir / "all" / "sweep.html")));
+    // Every run's directory, with the traces the failed runs kept, as one machine left them.
+    const std::set<std::string> kept = files_under(dir / "all" / "cases");
+    EXPECT_EQ(files_under(dir / "merged" / "cases"), kept);
+    for (const nlohmann::json& seed : tight.at("failed_seeds")) {
+        EXPECT_TRUE(kept.count("short-fusion-tight-seed" + seed.dump() + "/trace.sqlite")) << seed;
+    }
+}
+
+// Shards that are not every shard of one sweep, once, are refused before
+// anything is written, naming the directory.
+TEST(SweepShard, MergesThatCannotBeRightAreRefusedBeforeWriting) {
+    const fs::path dir = fresh_dir("sweep-shard-refused");
+    const std::string short_case = quoted(RIG_SOURCE_DIR "/tests/data/short-fusion.yaml");
+    const std::string sweep = kRig + " sweep " + short_case + " --in-process --keep-traces none -q";
+    for (const auto& [args, out] : std::vector<std::pair<std::string, std::string>>{{" --seeds 2 --shard 1/2", "s1"},
+                                                                                     {" --seeds 2 --shard 2/2", "s2"},
+                                                                                     {" --seeds 3 --shard 2/2", "other-seeds"},
+                                                                                     {" --seeds 2", "unsharded"}}) {
+        const auto run = run_shell(sweep + args + " --out " + quoted(dir / out) + " 2>&1");
+        ASSERT_EQ(run.exit_code, 0) << args << ":\n" << run.output;
+    }
+    const auto run = run_shell(kRig + " run " + short_case + " --in-process --out " + quoted(dir / "a-run") + " 2>&1");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+
+    int attempt = 0;
+    auto refused = [&](const std::vector<std::string>& shards, const std::string& said) {
+        const fs::path out = dir / ("merged-" + std::to_string(++attempt));
+        std::string command = kRig + " merge";
+        for (const std::string& shard : shards) command += " " + quoted(dir / shard);
+        const auto merged = run_shell(command + " --out " + quoted(out) + " 2>&1");
+        EXPECT_EQ(merged.exit_code, 2) << merged.output;
+        EXPECT_NE(merged.output.find(said), std::string::npos) << "wanted: " << said << "\n" << merged.output;
+        EXPECT_FALSE(fs::exists(out)) << merged.output;
+    };
+    refused({"s1"}, "shard 2/2 is missing");
+    refused({"s1", "s1"}, (dir / "s1").string() + " and " + (dir / "s1").string() + " are both shard 1/2");
+    refused({"s1", "other-seeds"}, (dir / "other-seeds").string() + " is not a shard of the sweep in " +
+                                       (dir / "s1").string() + ": its seeds [1,2,3], not [1,2]");
+    refused({"s1", "unsharded"}, (dir / "unsharded" / "sweep.json").string() + ": a sweep without --shard");
+    refused({"s1", "no-such-dir"}, (dir / "no-such-dir").string() + ": not a rig run --out directory, nor a rig sweep one");
+    refused({"s1", "a-run"}, (dir / "s1").string() + " is the output of rig sweep, " + (dir / "a-run").string() + " is not");
+
+    // The two that belong together do merge; the shards are left as they were.
+    const std::set<std::string> before = files_under(dir / "s1");
+    const auto merged = run_shell(kRig + " merge " + quoted(dir / "s2") + " " + quoted(dir / "s1") + " --out " +
+                                  quoted(dir / "merged") + " 2>&1");
+    EXPECT_EQ(merged.exit_code, 0) << merged.output;
+    EXPECT_EQ(sweep_json_of(dir / "merged").at("cases").at(0).at("runs"), 2);
+    EXPECT_EQ(files_under(dir / "s1"), before);
+
+    // A bad --shard is a usage error, before any run.
+    const auto bad = run_shell(sweep + " --seeds 2 --shard 0/2 --out " + quoted(dir / "bad") + " 2>&1");
+    EXPECT_EQ(bad.exit_code, 2) << bad.output;
+    EXPECT_NE(bad.output.find("rig sweep: --shard '0/2': needs 1 <= I <= N <= 1000"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(dir / "bad" / "sweep.json"));
 }

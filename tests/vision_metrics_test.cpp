@@ -118,13 +118,30 @@ TEST(VisionMetrics, NothingJudgedOrNothingMeasuredIsNamedNotZero) {
 TEST(VisionMetrics, DoseByCoverSplitsAtSec52s40Percent) {
     const std::vector<RoiJudged> rois = {roi(0, 0.26, 0.26, 40.0), roi(0, 0.399, 0.4, 40.0), roi(1, 0.40, 0.4, 100.0),
                                          roi(1, 0.56, 0.56, 100.0), roi(1, 0.56, 0.56, 100.0)};
-    const std::map<std::string, double> m = dose_by_cover_metrics(rois, {1.0, 0.5, 2.0, 1.5, std::nan("")});
+    std::map<std::string, std::string> not_measured;
+    const std::map<std::string, double> m = dose_by_cover_metrics(rois, {1.0, 0.5, 2.0, 1.5, 3.0}, not_measured);
+    EXPECT_TRUE(not_measured.empty());
     EXPECT_EQ(m.at("vision_sparse_rois_count"), 2.0);
-    EXPECT_EQ(m.at("vision_normal_rois_count"), 2.0);  // the NaN dose (off the grid) is left out
+    EXPECT_EQ(m.at("vision_normal_rois_count"), 3.0);
     EXPECT_DOUBLE_EQ(m.at("vision_dose_sparse_rois_ul_cm2"), 0.75);
-    EXPECT_DOUBLE_EQ(m.at("vision_dose_normal_rois_ul_cm2"), 1.75);
-    EXPECT_EQ(dose_by_cover_metrics({}, {}).count("vision_dose_sparse_rois_ul_cm2"), 0u);
-    EXPECT_THROW(dose_by_cover_metrics(rois, {1.0}), std::invalid_argument);
+    EXPECT_DOUBLE_EQ(m.at("vision_dose_normal_rois_ul_cm2"), 6.5 / 3.0);
+    EXPECT_EQ(dose_by_cover_metrics({}, {}, not_measured).count("vision_dose_sparse_rois_ul_cm2"), 0u);
+    EXPECT_THROW(dose_by_cover_metrics(rois, {1.0}, not_measured), std::invalid_argument);
+}
+
+TEST(VisionMetrics, AClassWithARoiOffTheJudgedGroundHasNoMeanDose) {
+    // The last normal ROI's square reaches off the ground (NaN): the normal
+    // mean over the other two would be another set's mean; the sparse one stands.
+    const std::vector<RoiJudged> rois = {roi(0, 0.26, 0.26, 40.0), roi(0, 0.399, 0.4, 40.0), roi(1, 0.40, 0.4, 100.0),
+                                         roi(1, 0.56, 0.56, 100.0), roi(1, 0.56, 0.56, 100.0)};
+    std::map<std::string, std::string> not_measured;
+    const std::map<std::string, double> m = dose_by_cover_metrics(rois, {1.0, 0.5, 2.0, 1.5, std::nan("")}, not_measured);
+    EXPECT_DOUBLE_EQ(m.at("vision_dose_sparse_rois_ul_cm2"), 0.75);
+    EXPECT_EQ(m.count("vision_dose_normal_rois_ul_cm2"), 0u);
+    EXPECT_EQ(not_measured.at("vision_dose_normal_rois_ul_cm2"),
+              "1 of the 3 normal ROIs' squares reach off the judged ground (judge.ground): their dose is unknown");
+    EXPECT_EQ(not_measured.count("vision_dose_sparse_rois_ul_cm2"), 0u);
+    EXPECT_EQ(m.at("vision_normal_rois_count"), 3.0);
 }
 
 TEST(VisionMetrics, PapersAverageCoverageOverTheirCellsAndTheStripItsDose) {
@@ -139,10 +156,20 @@ TEST(VisionMetrics, PapersAverageCoverageOverTheirCellsAndTheStripItsDose) {
     EXPECT_EQ(m.at("dose_mean_ul_cm2"), 1.0);
     EXPECT_THROW(paper_metrics({DoseCells{}}, model), std::invalid_argument);
 
-    const std::map<std::string, double> strip = strip_metrics(DoseCells{{2.0, 0.0, 2.0, 0.0}}, model);
+    std::map<std::string, std::string> not_measured;
+    const std::map<std::string, double> strip = strip_metrics(DoseCells{{2.0, 0.0, 2.0, 0.0}}, model, not_measured);
     EXPECT_EQ(strip.at("strip_dose_mean_ul_cm2"), 1.0);
     EXPECT_NEAR(strip.at("strip_dose_cv_pct"), 100.0 * std::sqrt(4.0 / 3.0), 1e-9);
-    EXPECT_THROW(strip_metrics(DoseCells{}, model), std::invalid_argument);
+    EXPECT_TRUE(not_measured.empty());
+    EXPECT_THROW(strip_metrics(DoseCells{}, model, not_measured), std::invalid_argument);
+    // Nothing laid, or one cell: no spread to measure, never a CV of 0 (perfectly even).
+    const std::map<std::string, double> bare = strip_metrics(DoseCells{{0.0, 0.0, 0.0}}, model, not_measured);
+    EXPECT_EQ(bare.at("strip_dose_mean_ul_cm2"), 0.0);
+    EXPECT_EQ(bare.count("strip_dose_cv_pct"), 0u);
+    EXPECT_EQ(not_measured.at("strip_dose_cv_pct"), "nothing was laid on the strip");
+    not_measured.clear();
+    EXPECT_EQ(strip_metrics(DoseCells{{2.0}}, model, not_measured).count("strip_dose_cv_pct"), 0u);
+    EXPECT_EQ(not_measured.at("strip_dose_cv_pct"), "the strip holds one ground cell: no spread to measure");
 
     const GroundRect card = paper_at(1.0, -2.0);
     EXPECT_NEAR(card.east_max_m - card.east_min_m, 0.076, 1e-12);

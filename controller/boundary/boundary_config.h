@@ -46,6 +46,10 @@ struct BoundaryControllerFaults {
     // only, so nozzles inside spray while the boom centre is outside (the
     // headland double spray of spraying environment 2).
     bool ignore_centre_rule = false;
+    // A duty message that turns any nozzle on carries one entry more than the
+    // boom has nozzles (a fill loop that runs to <= nozzle_count): 7 duties
+    // for 6 nozzles, which the plant refuses (malformed_command).
+    bool extra_duty_entry = false;
     // Every duty command goes out this long after the logic decided it (case
     // time): a controller that acts late, e.g. an output task fed through a
     // queue (controller/boundary/duty_command_delay.h). [0, 2] s.

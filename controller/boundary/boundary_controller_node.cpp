@@ -228,6 +228,9 @@ TimeNs BoundaryControllerNode::step(TimeNs now_ns) {
     for (std::vector<double>& due : commands_.take_due(now_ns)) {
         msg::NozzlePwm pwm;
         pwm.frequency_hz(logic_.pwm_frequency_hz());
+        // TEST-ONLY fault: a message that sprays has a duty for a nozzle the boom does not have.
+        const bool spraying = std::any_of(due.begin(), due.end(), [](double pct) { return pct > 0.0; });
+        if (logic_.config().faults.extra_duty_entry && spraying) due.push_back(due.back());
         pwm.duty_pct(std::move(due));
         pwm_writer_->publish(pwm);
     }

@@ -76,6 +76,7 @@ BoundaryNodeConfig parse_section(const YamlSection& section, const std::optional
     c.faults.ignore_boom_height = faults.optional<bool>("ignore_boom_height", false);
     c.faults.lookahead_sign_flipped = faults.optional<bool>("lookahead_sign_flipped", false);
     c.faults.ignore_centre_rule = faults.optional<bool>("ignore_centre_rule", false);
+    c.faults.extra_duty_entry = faults.optional<bool>("extra_duty_entry", false);
     read_double(faults, "command_delay_s", c.faults.command_delay_s);
 
     // The cameras on the boom are used unless the section says how (or not).

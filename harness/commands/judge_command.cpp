@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 #include "harness/systems/systems.h"
 #include "harness/report/html_report.h"
 #include "harness/report/results_writer.h"
+#include "harness/report/sweep_shard.h"
 #include "harness/run/run_progress.h"
 
 namespace rig::harness {
@@ -107,6 +109,94 @@ std::vector<std::string> differences_from_run(const CaseResult& now, const nlohm
     return {now.name + ": not in " + results_file.string()};
 }
 
+// The exit status of a re-judging with `differences` from the recorded
+// results: kExitRejudgedDiffers first, then as `rig run` (1 failed, 3 invalid, 0).
+int rejudged_exit_status(const RunSummary& summary, std::size_t differences) {
+    if (differences > 0) return kExitRejudgedDiffers;
+    if (summary.failed > 0) return 1;
+    return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
+}
+
+// Its last line: "re-judged: every metric, verdict and digest as recorded;
+// 2 case(s) failed, as recorded (exit status 1)", or the differences' count
+// and exit status 5. `recorded_by`: "recorded", "the shards recorded".
+std::string rejudged_last_line(const RunSummary& summary, std::size_t differences, const std::string& recorded_by) {
+    if (differences > 0) {
+        return "re-judged: " + std::to_string(differences) + " difference(s) from the results " + recorded_by +
+               ": the judging changed, whatever the verdicts (exit status " + std::to_string(kExitRejudgedDiffers) + ")";
+    }
+    std::string line = "re-judged: every metric, verdict and digest as " + recorded_by;
+    if (summary.failed > 0) {
+        line += "; " + std::to_string(summary.failed) + " case(s) failed, as recorded (exit status 1)";
+    } else if (summary.invalid > 0) {
+        line += "; " + std::to_string(summary.invalid) + " case(s) invalid, as recorded (exit status 3)";
+    }
+    return line;
+}
+
+// rig merge's --out: new or empty, so that nothing of another run is taken for the merge's.
+void check_merge_out(const fs::path& out_dir) {
+    if (out_dir.empty()) throw std::runtime_error("--out DIR is required");
+    if (fs::exists(out_dir) && !(fs::is_directory(out_dir) && fs::is_empty(out_dir))) {
+        throw std::runtime_error(out_dir.string() + " exists and is not an empty directory");
+    }
+}
+
+// Whether the directories are rig sweep outputs (sweep.json) rather than rig
+// run ones; throws, naming them, on a mix or on a directory holding both.
+bool are_sweep_outputs(const std::vector<std::string>& dirs) {
+    std::optional<std::string> a_sweep, a_run;
+    for (const std::string& dir : dirs) {
+        if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a rig run --out directory, nor a rig sweep one");
+        const bool sweep = fs::exists(fs::path(dir) / "sweep.json");
+        if (sweep && fs::exists(fs::path(dir) / "results.json")) {
+            throw std::runtime_error(dir + " holds both a rig run's results.json and a rig sweep's sweep.json: "
+                                           "give each its own --out");
+        }
+        (sweep ? a_sweep : a_run) = dir;
+    }
+    if (a_sweep && a_run) {
+        throw std::runtime_error(*a_sweep + " is the output of rig sweep, " + *a_run +
+                                 " is not: merge the shards of one command");
+    }
+    return a_sweep.has_value();
+}
+
+// The outputs of rig sweep --shard I/N joined (harness/report/sweep_shard.h):
+// each shard's cases/RUN/ (what it kept of each run) copied into --out, and
+// sweep.json, sweep.txt and sweep.html written as one machine's sweep.
+int merge_sweep_outputs(const MergeCommandOptions& options, std::ostream& out, std::ostream& err) {
+    MergedSweep merged;
+    try {
+        std::vector<SweepShardOutput> outputs;
+        for (const std::string& dir : options.shard_dirs) outputs.push_back({dir, read_json(fs::path(dir) / "sweep.json")});
+        merged = merge_sweep_shards(outputs);
+    } catch (const std::exception& error) {
+        err << "rig merge: " << error.what() << "\n";
+        return 2;
+    }
+    try {
+        fs::create_directories(options.out_dir / "cases");
+        for (std::size_t i = 0; i < options.shard_dirs.size(); ++i) {
+            for (const std::string& run : merged.runs_of_shard[i]) {
+                const fs::path kept = fs::path(options.shard_dirs[i]) / "cases" / run;
+                if (fs::is_directory(kept)) fs::copy(kept, options.out_dir / "cases" / run, fs::copy_options::recursive);
+            }
+        }
+        write_sweep_files(options.out_dir, merged.json, merged.cases, merged.info);
+    } catch (const std::exception& error) {
+        err << "rig merge: cannot write the merged sweep in " << options.out_dir.string() << ": " << error.what() << "\n";
+        return 2;
+    }
+    std::size_t passed = 0;
+    for (const CaseSweep& sweep : merged.cases) passed += sweep.passed;
+    out << sweep_table(merged.cases, merged.info) << "merged " << merged.runs << " runs from "
+        << options.shard_dirs.size() << " shards\n"
+        << "sweep: " << (options.out_dir / "sweep.json").string() << ", " << (options.out_dir / "sweep.txt").string()
+        << ", " << (options.out_dir / "sweep.html").string() << "\n";
+    return passed == merged.runs ? 0 : 1;  // as rig sweep
+}
+
 }  // namespace
 
 int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std::ostream& err) {
@@ -173,32 +263,28 @@ int run_judge_command(const JudgeCommandOptions& options, std::ostream& out, std
         }
     }
     out << result_table(results, summary, colour_wanted(STDOUT_FILENO));
-    if (options.check) {
-        for (const std::string& difference : differing) out << "differs: " << difference << "\n";
-        out << (differing.empty() ? "re-judged: every metric, verdict and digest as recorded\n"
-                                  : "re-judged: " + std::to_string(differing.size()) + " difference(s)\n");
-    }
     if (!options.out_dir.empty()) out << "results: " << (options.out_dir / "results.json").string() << "\n";
-    if (summary.failed > 0 || !differing.empty()) return 1;
-    return summary.invalid > 0 ? 3 : 0;  // as `rig run`: invalid runs, nothing failed
+    if (options.check) {
+        // Last: a CI reads from it whether the controller failed or the judging changed.
+        for (const std::string& difference : differing) out << "differs: " << difference << "\n";
+        out << rejudged_last_line(summary, differing.size(), "recorded") << "\n";
+    }
+    return rejudged_exit_status(summary, differing.size());
 }
 
 int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std::ostream& err) {
-    struct Shard {
+    struct RunShard {
         fs::path dir;
         nlohmann::json results;
         std::vector<fs::path> case_dirs;
     };
-    std::vector<Shard> shards;
+    std::vector<RunShard> shards;
     try {
-        if (options.out_dir.empty()) throw std::runtime_error("--out DIR is required");
-        if (fs::exists(options.out_dir) && !(fs::is_directory(options.out_dir) && fs::is_empty(options.out_dir))) {
-            throw std::runtime_error(options.out_dir.string() + " exists and is not an empty directory");
-        }
+        check_merge_out(options.out_dir);
+        if (are_sweep_outputs(options.shard_dirs)) return merge_sweep_outputs(options, out, err);
         std::map<std::string, fs::path> shard_of_case;
         for (const std::string& argument : options.shard_dirs) {
-            Shard shard{argument, {}, {}};
-            if (!fs::is_directory(shard.dir)) throw std::runtime_error(argument + ": not a rig run --out directory");
+            RunShard shard{argument, {}, {}};
             shard.results = read_json(shard.dir / "results.json");
             for (const Input& input : traces_of_run(shard.dir)) {
                 const fs::path case_dir = input.trace.parent_path();
@@ -222,7 +308,7 @@ int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std
     std::vector<std::string> differing;
     try {
         fs::create_directories(options.out_dir / "cases");
-        for (const Shard& shard : shards) {
+        for (const RunShard& shard : shards) {
             for (const fs::path& case_dir : shard.case_dirs) {
                 const fs::path copy = options.out_dir / "cases" / case_dir.filename();
                 fs::copy(case_dir, copy, fs::copy_options::recursive);
@@ -248,13 +334,11 @@ int run_merge_command(const MergeCommandOptions& options, std::ostream& out, std
         return 2;
     }
     out << result_table(results, summary, isatty(STDOUT_FILENO) != 0);
+    out << "merged " << results.size() << " cases from " << shards.size() << " shards into "
+        << (options.out_dir / "results.json").string() << "\n";
     for (const std::string& difference : differing) out << "differs: " << difference << "\n";
-    out << "merged " << results.size() << " cases from " << shards.size() << " shards; "
-        << (differing.empty() ? "every metric, verdict and digest as the shards recorded\n"
-                              : std::to_string(differing.size()) + " difference(s) from the shards\n");
-    out << "results: " << (options.out_dir / "results.json").string() << "\n";
-    if (summary.failed > 0 || !differing.empty()) return 1;
-    return summary.invalid > 0 ? 3 : 0;
+    out << rejudged_last_line(summary, differing.size(), "the shards recorded") << "\n";
+    return rejudged_exit_status(summary, differing.size());
 }
 
 JudgeCommand::JudgeCommand(CLI::App& app) {
@@ -272,8 +356,10 @@ int JudgeCommand::run() { return run_judge_command(options_, std::cout, std::cer
 
 MergeCommand::MergeCommand(CLI::App& app) {
     command_ = app.add_subcommand(
-        "merge", "join the outputs of rig run --shard I/N into one run directory (results.json, junit.xml, reports)");
-    command_->add_option("shard_outs", options_.shard_dirs, "the shards' rig run --out directories")->required();
+        "merge", "join the outputs of rig run --shard I/N into one run directory (results.json, junit.xml, reports), or "
+                 "those of rig sweep --shard I/N into one sweep (sweep.json, sweep.txt, sweep.html)");
+    command_->add_option("shard_outs", options_.shard_dirs, "the shards' rig run or rig sweep --out directories")
+        ->required();
     command_->add_option("--out", options_.out_dir, "the merged run directory (new or empty)")->required();
 }
 

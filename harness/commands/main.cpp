@@ -2,6 +2,7 @@
 // The table of subcommands is below; each lives beside what it runs:
 //   rig run, rig sweep          harness/commands/run_command.h
 //   rig judge, rig merge        harness/commands/judge_command.h
+//   rig diff                    harness/commands/diff_command.h
 //   rig compare                 harness/commands/compare_command.h
 //   rig bench                   harness/commands/bench_command.h
 //   rig dds-check               harness/commands/dds_check_command.h
@@ -27,6 +28,7 @@
 #include "harness/commands/bench_command.h"
 #include "harness/commands/compare_command.h"
 #include "harness/commands/dds_check_command.h"
+#include "harness/commands/diff_command.h"
 #include "harness/commands/history_command.h"
 #include "harness/commands/judge_command.h"
 #include "harness/commands/mcap_command.h"
@@ -123,6 +125,7 @@ int main(int argc, char** argv) {
     commands.push_back(std::make_unique<RunCommand>(app));
     commands.push_back(std::make_unique<JudgeCommand>(app));
     commands.push_back(std::make_unique<MergeCommand>(app));
+    commands.push_back(std::make_unique<DiffCommand>(app));
     commands.push_back(std::make_unique<SweepCommand>(app));
     commands.push_back(std::make_unique<CompareCommand>(app));
     commands.push_back(std::make_unique<NmeaCommand>(app));

@@ -17,6 +17,7 @@
 #include "harness/report/html_report.h"
 #include "harness/report/results_writer.h"
 #include "harness/report/sweep.h"
+#include "harness/report/sweep_shard.h"
 #include "harness/run/output_dir.h"
 #include "harness/run/run_interrupt.h"
 #include "harness/run/run_progress.h"
@@ -48,6 +49,13 @@ RunOptions default_run_options() {
 }
 
 namespace {
+
+// What a shard of a run or a sweep holds, said on standard error before it runs.
+void say_shard(const std::string& command, const Shard& shard, std::size_t held, std::size_t all,
+               const std::string& what) {
+    std::cerr << command << ": shard " << shard.index << "/" << shard.count << ": " << held << " of " << all << " "
+              << what << " (join the shards' outputs with rig merge)\n";
+}
 
 // Every case file read and validated before anything starts (the errors go to
 // standard error, and nothing is run: nullopt).
@@ -89,14 +97,27 @@ std::optional<std::vector<CaseSpec>> load_cases(const std::vector<std::string>& 
         if (shard) {
             const std::size_t all = specs.size();
             std::erase_if(specs, [&](const CaseSpec& spec) { return !in_shard(spec.name, *shard); });
-            std::cerr << "rig: shard " << shard->index << "/" << shard->count << ": " << specs.size() << " of " << all
-                      << " cases (join the shards' outputs with rig merge)\n";
+            say_shard("rig", *shard, specs.size(), all, "cases");
         }
     } catch (const std::exception& error) {
         std::cerr << "rig: " << error.what() << "\n";
         return std::nullopt;
     }
     return specs;
+}
+
+// --shard's value (nullopt without it); false after saying on standard error
+// what is wrong with it.
+bool shard_option_value(const CLI::Option* option, const std::string& text, const std::string& command,
+                        std::optional<Shard>& shard) {
+    if (option->count() == 0) return true;
+    try {
+        shard = parse_shard(text);
+        return true;
+    } catch (const std::invalid_argument& error) {
+        std::cerr << command << ": " << error.what() << "\n";
+        return false;
+    }
 }
 
 // Refuses an output directory that cannot take results (before any case runs),
@@ -267,6 +288,7 @@ struct SweepArguments {
     std::uint64_t first_seed = 1;
     std::string keep_traces = "failed";
     std::string bmf_file;
+    std::optional<Shard> shard;
 };
 
 
@@ -282,6 +304,8 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
     std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, std::nullopt);
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
+    // Every case file was checked above, whichever shard its runs are in.
+    options.sweep_shard = sweep.shard;
     for (const CaseSpec& spec : specs) {
         if (spec.mode == ClockMode::realtime) {
             std::cerr << "rig sweep: " << spec.source_path.string()
@@ -291,6 +315,8 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
         }
     }
     if (!prepare_run(options, verbosity)) return 2;
+    const std::size_t runs_in_sweep = specs.size() * options.seed_sweep.size();
+    if (sweep.shard) say_shard("rig sweep", *sweep.shard, expand_runs(specs, options).size(), runs_in_sweep, "runs");
     install_run_interrupt_handlers();
     const rig::WallStopwatch wall;
     SweepInfo info;
@@ -314,14 +340,13 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
     const std::vector<CaseInstance> instances = expand_runs(specs, options);
     const std::vector<CaseSweep> cases = summarize_sweep(specs, instances, results);
     const std::string table = sweep_table(cases, info);
+    nlohmann::json json = sweep_json(cases, instances, results, info);
+    if (sweep.shard) json["shard"] = sweep_shard_json(*sweep.shard, specs, runs_in_sweep, instances, results);
     try {
-        const nlohmann::json written = sweep_json(cases, instances, results, info);
-        write_file_atomically(options.out_dir / "sweep.json", written.dump(1) + "\n");
-        if (!write_bencher_file("sweep", sweep.bmf_file, written, "sweep", options.out_dir / "sweep.json")) {
+        write_sweep_files(options.out_dir, json, cases, info);
+        if (!write_bencher_file("sweep", sweep.bmf_file, json, "sweep", options.out_dir / "sweep.json")) {
             return kExitResultsNotWritten;
         }
-        write_file_atomically(options.out_dir / "sweep.txt", table);
-        write_file_atomically(options.out_dir / "sweep.html", sweep_html(cases, info));
     } catch (const std::exception& error) {
         std::cout << table;
         std::cerr << "rig sweep: results not written: " << error.what() << "\n";
@@ -386,14 +411,7 @@ int RunCommand::run() {
         options.domain = domain_;
     }
     std::optional<Shard> shard;
-    if (shard_option_->count() > 0) {
-        try {
-            shard = parse_shard(shard_text_);
-        } catch (const std::invalid_argument& error) {
-            std::cerr << "rig run: " << error.what() << "\n";
-            return 2;
-        }
-    }
+    if (!shard_option_value(shard_option_, shard_text_, "rig run", shard)) return 2;
     const auto verbosity = quiet_ ? Verbosity::quiet : verbose_ ? Verbosity::verbose : Verbosity::normal;
     return run_command(inputs_, options, shard, verbosity, bmf_file_);
 }
@@ -416,6 +434,9 @@ SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
     sweep->add_flag("--in-process", options_.in_process,
                     "software-in-the-loop, as rig run --in-process (same digests, several times faster)");
     sweep->add_flag("!--no-pin", options_.pin_cpu, kNoPinHelp);
+    shard_option_ = sweep->add_option("--shard", shard_text_,
+                                      "I/N: run only shard I of N of the sweep's runs (case and seed pairs, dealt in "
+                                      "turn), e.g. one job of a CI matrix; rig merge joins them");
     sweep->add_flag("--quiet,-q", quiet_, "print only the summary line: no progress, no table");
     sweep->add_option("--bmf", bmf_file_, "also write every case's metrics (median, min, max) in Bencher's JSON format to this file");
 }
@@ -423,8 +444,9 @@ SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
 bool SweepCommand::parsed() const { return command_->parsed(); }
 
 int SweepCommand::run() {
-    return sweep_command(inputs_, options_, SweepArguments{seeds_, first_seed_, keep_traces_, bmf_file_},
-                         quiet_ ? Verbosity::quiet : Verbosity::normal);
+    SweepArguments sweep{seeds_, first_seed_, keep_traces_, bmf_file_, std::nullopt};
+    if (!shard_option_value(shard_option_, shard_text_, "rig sweep", sweep.shard)) return 2;
+    return sweep_command(inputs_, options_, sweep, quiet_ ? Verbosity::quiet : Verbosity::normal);
 }
 
 }  // namespace rig::harness

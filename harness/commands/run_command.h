@@ -5,7 +5,7 @@
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N]
 //                          [--shard I/N] [--no-pin] [--quiet | --verbose]
 //   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N]
-//                          [--in-process] [--no-pin] [--quiet]
+//                          [--shard I/N] [--in-process] [--no-pin] [--quiet]
 // Exit status of both: 0 all passed, 1 a case failed, 2 a usage or case-file
 // error (nothing ran), 3 (run) nothing failed but a real-time case was invalid,
 // 4 the results could not be written, 128 + N after signal N.
@@ -67,6 +67,8 @@ private:
     std::uint64_t seeds_ = 0;
     std::uint64_t first_seed_ = 1;
     std::string keep_traces_ = "failed";
+    std::string shard_text_;
+    CLI::Option* shard_option_ = nullptr;
     bool quiet_ = false;
     std::string bmf_file_;
 };

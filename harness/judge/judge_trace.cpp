@@ -98,12 +98,14 @@ void read_run_facts(const RecordedTrace& trace, CaseResult& result, CaseFigures&
 // A real-time run whose own emissions passed the case's lateness bound cannot
 // judge the controller: its verdict is invalid (rig_overloaded), whatever the
 // controller did, unless the run already ended in something the lateness does
-// not explain (a stop signal, the rig's own error, a broken topic role).
+// not explain (a stop signal, the rig's own error, a broken topic role, a
+// malformed actuator command: late inputs change a command's timing, never
+// its shape).
 void apply_rig_overload(CaseResult& result) {
     if (!result.rig_lateness.is_object()) return;
     const std::string overloaded = result.rig_lateness.value("overloaded", std::string());
     if (overloaded.empty()) return;
-    for (const char* kept : {"interrupted", "harness_error", "topic_role_violation"}) {
+    for (const char* kept : {"interrupted", "harness_error", "topic_role_violation", "malformed_command"}) {
         if (result.error_kind == kept) return;
     }
     std::string error = "the rig was overloaded: " + overloaded +

@@ -23,7 +23,7 @@ const std::vector<MetricDeclaration> kDeclarations = {
     // Seed 000: flow control (Tables 1, 2, 5, Fig. 12, 14)
     {"flow_adjust_time_s", W::up, 0.05, "nozzle start to settled within +-3 % (limited)"},
     {"flow_adjust_time_from_command_s", W::up, 0.05, "the same from the section-open command"},
-    {"flow_error_pct", W::up, 0.05, "mean |Q - target| / target once due to be steady (limited)"},
+    {"flow_error_pct", W::up, 0.05, "mean absolute flow error over the target once due to be steady (limited)"},
     {"flow_error_kf11_signed_pct", W::away_from_zero, 0.05, "the paper's signed KF11 error (Table 5)"},
     {"flow_error_kf11_settled_signed_pct", W::away_from_zero, 0.05, "the same over the settled stretch"},
     {"flow_oscillation_pct", W::up, 0.1, "peak-to-peak of the flow over the last 3 s (Fig. 12)"},

@@ -3,6 +3,7 @@
 #include <csignal>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -32,6 +33,13 @@ constexpr std::chrono::milliseconds kWireUnreadBound{2000};
 // Everything no node reports, checked in every wait slice and after every round:
 // a stop signal, the case's wall-time bound, roles seen in discovery, forged
 // samples, a bench wire nobody reads. Throws NodeFailure naming the culprit.
+//
+// While the master starts, a role broken by an endpoint discovery saw is held
+// until the hellos are checked: a node that declares the topic in its hello
+// is then caught by its hello, the same point and the same reason in every
+// run, however its announcement raced its hello (docs/controller-contract.md
+// section 4, docs/metrics.md "Topic roles"). An undeclared one is thrown right
+// after the hello check.
 class Watchdog {
 public:
     Watchdog(const TimeoutsSpec& timeouts, const WallStopwatch& wall, DdsContext& dds, TraceRecorder& trace,
@@ -54,8 +62,10 @@ public:
             if (endpoint.removed) continue;
             if (endpoint.writer) writer_types_[endpoint.topic] = endpoint.type;
             if (const auto why = topic_role_violation(endpoint.writer ? "writer" : "reader", endpoint.topic)) {
-                throw NodeFailure(FailureKind::topic_role_violation, endpoint.participant,
-                                  *why + " (GUID prefix " + endpoint.guid_prefix + ", seen by discovery)");
+                NodeFailure violation(FailureKind::topic_role_violation, endpoint.participant,
+                                      *why + " (GUID prefix " + endpoint.guid_prefix + ", seen by discovery)");
+                if (!holding_) throw violation;
+                if (!held_) held_ = std::move(violation);
             }
         }
         if (!trace_.foreign_samples().empty()) {
@@ -69,6 +79,29 @@ public:
         }
     }
 
+    // From the master's start to its hello check: discovery's role violations are held.
+    void hold_discovery_violations() { holding_ = true; }
+    // The hellos are checked (or there were none): a held violation is thrown
+    // now, and later ones as discovery sees them.
+    void release_discovery_violations() {
+        holding_ = false;
+        if (held_) {
+            const NodeFailure violation = *held_;
+            held_.reset();
+            throw violation;
+        }
+    }
+    // The start-up ended in `failure` before its hellos were checked: a
+    // violation held by then was seen first and is the run's end, unless
+    // `failure` is a stop signal (the operator's, whatever the node did) or
+    // the hello's own violation.
+    void prefer_held_violation_to(const NodeFailure& failure) {
+        holding_ = false;
+        if (held_ && failure.kind() != FailureKind::interrupted && failure.kind() != FailureKind::topic_role_violation) {
+            throw *held_;
+        }
+    }
+
     // The type another process's writer announced for a topic, once discovery saw it.
     std::optional<std::string> writer_type(const std::string& topic) const {
         const auto it = writer_types_.find(topic);
@@ -77,6 +110,8 @@ public:
 
 private:
     std::map<std::string, std::string> writer_types_;
+    bool holding_ = false;
+    std::optional<NodeFailure> held_;
     const TimeoutsSpec& timeouts_;
     const WallStopwatch& wall_;
     DdsContext& dds_;
@@ -89,7 +124,8 @@ private:
 // What the controller said in its hello. A topic it may not read or write
 // fails the case here, before time starts: the same point in every run, where
 // discovery would tell it whenever its announcement happened to arrive (and
-// the trace would hold a varying part of the first instant). Topics it writes
+// the trace would hold a varying part of the first instant); what discovery
+// found before it waits for this check (Watchdog). Topics it writes
 // that the rig has no type for (its own diagnostics) are recorded as raw
 // samples, so they are matched, counted and kept like any other.
 void check_hello_topics(const std::vector<LockstepMaster::HelloTopics>& hellos, TraceRecorder& trace,
@@ -99,6 +135,7 @@ void check_hello_topics(const std::vector<LockstepMaster::HelloTopics>& hellos, 
             throw NodeFailure(FailureKind::topic_role_violation, hello.node, *why);
         }
     }
+    watchdog.release_discovery_violations();
     std::set<std::string> unknown;
     for (const LockstepMaster::HelloTopics& hello : hellos) {
         for (const std::string& topic : hello.published) {
@@ -118,6 +155,20 @@ void check_hello_topics(const std::vector<LockstepMaster::HelloTopics>& hellos, 
         }
         trace.record_raw(topic, *watchdog.writer_type(topic));
     }
+}
+
+// Starts `master` with discovery's role violations held until its hellos are
+// checked (Watchdog above).
+template <class Master>
+void start_hellos_first(Master& master, Watchdog& watchdog) {
+    watchdog.hold_discovery_violations();
+    try {
+        master.start();
+    } catch (const NodeFailure& failure) {
+        watchdog.prefer_held_violation_to(failure);
+        throw;
+    }
+    watchdog.release_discovery_violations();  // a run without remote nodes has no hello
 }
 
 // The rig's own lateness against the case's bound, for the judge's verdict
@@ -176,7 +227,7 @@ void run_lockstep(const TimeoutsSpec& timeouts, DdsContext& dds, SystemNodes& no
         check_hello_topics(hellos, trace, watchdog);
     });
     try {
-        master.start();
+        start_hellos_first(master, watchdog);
         facts.startup_wall_seconds = wall.elapsed_s();
         while (master.advance(end_ns)) ++facts.instants;
         facts.stepping_wall_seconds = wall.elapsed_s() - facts.startup_wall_seconds;
@@ -249,7 +300,7 @@ void run_realtime(const CaseSpec& spec, DdsContext& dds, SystemNodes& nodes, Cas
         if (spec.wiring.external_controller) {
             board = wait_for_board(spec.board, session.wires(), [&watchdog] { watchdog(); });
         }
-        master.start();
+        start_hellos_first(master, watchdog);
         facts.startup_wall_seconds = wall.elapsed_s();
         master.run_until(end_ns);
         master.shutdown();

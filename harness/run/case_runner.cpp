@@ -181,10 +181,13 @@ void validate_for_run(const CaseSpec& spec, const RunOptions& options) {
 
 std::vector<CaseInstance> expand_runs(const std::vector<CaseSpec>& specs, const RunOptions& options) {
     std::vector<CaseInstance> runs;
+    std::size_t sweep_runs = 0;  // the sweep's runs so far, this shard's or not
     for (std::size_t i = 0; i < specs.size(); ++i) {
         const CaseSpec& spec = specs[i];
         if (!options.seed_sweep.empty()) {
             for (std::uint64_t seed : options.seed_sweep) {
+                const std::size_t index = sweep_runs++;
+                if (options.sweep_shard && !run_in_shard(index, *options.sweep_shard)) continue;
                 runs.push_back(CaseInstance{i, seed, spec.name + "-seed" + std::to_string(seed)});
             }
             continue;

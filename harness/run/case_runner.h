@@ -20,6 +20,7 @@
 
 #include "harness/judge/judge_trace.h"
 #include "harness/run/case_loop.h"
+#include "harness/run/shard.h"
 #include "harness/spec/case_spec.h"
 #include "harness/systems/system.h"
 #include "rig/wire/hid_board.h"
@@ -50,6 +51,9 @@ struct RunOptions {
     // `rig sweep --seeds N`: every case runs once per seed here, as NAME-seedN
     // (a case's own seed or `seeds:` and --seed are then not used).
     std::vector<std::uint64_t> seed_sweep;
+    // `rig sweep --shard I/N`: only the sweep's runs of this shard
+    // (harness/run/shard.h shard_of_run); nullopt: every run.
+    std::optional<Shard> sweep_shard;
     // false: run_cases drops each run's figures as it ends (a sweep of
     // thousands of runs keeps only their numbers).
     bool keep_figures = true;

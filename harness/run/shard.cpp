@@ -38,4 +38,8 @@ int shard_of(const std::string& case_name, int count) {
     return static_cast<int>(hash % static_cast<std::uint64_t>(count)) + 1;
 }
 
+int shard_of_run(std::size_t run_index, int count) {
+    return static_cast<int>(run_index % static_cast<std::size_t>(count)) + 1;
+}
+
 }  // namespace rig::harness

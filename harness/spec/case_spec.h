@@ -104,7 +104,7 @@ struct ExpectSpec {
     // only when exactly these fail. Each must have a limit (file or default).
     std::vector<std::string> fail;
     // Or: the run must end in this kind of failure (rig::FailureKind names, e.g.
-    // node_exited, node_unresponsive, topic_role_violation); the case passes
+    // node_exited, node_unresponsive, topic_role_violation, malformed_command); the case passes
     // only when it does. Exclusive with `fail`.
     std::string error;
     // Whose behaviour the expectation describes: `reference` (the default), the

@@ -16,6 +16,7 @@
 //                    lockstep master steps;
 //   its judge        metrics and figures from a recorded trace alone (SystemJudge,
 //                    harness/judge/judge_trace.h);
+//   its key signals  what `rig diff --html` draws of two runs over each other;
 //   its reference controller, run when a case names none.
 #include <cstdint>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/judge/judge_trace.h"
+#include "harness/plot/gnuplot_panel.h"
 #include "harness/spec/case_spec.h"
 #include "harness/trace/run_facts.h"
 #include "rig/runtime/clock.h"
@@ -59,8 +61,8 @@ public:
     virtual void run_completed(TimeNs end_ns) { (void)end_ns; }
     // After the run, whatever its ending: what the trace keeps besides its
     // samples (seed 000: the spray on the ground, the faults injected) and the
-    // facts the system adds to the run's (seed 001: commands the plant refused,
-    // frames rendered); `case_dir` takes files for the report (camera frames).
+    // facts the system adds to the run's (seed 001: frames rendered); `case_dir`
+    // takes files for the report (camera frames).
     virtual void finish(TraceFile& trace, RunFacts& facts, const std::filesystem::path& case_dir) = 0;
 };
 
@@ -97,6 +99,15 @@ public:
     virtual std::unique_ptr<SystemNodes> make_nodes(BenchWires& wires) = 0;
 };
 
+// A signal of one run over simulated time, as `rig diff --html` draws it for
+// two runs of a case over each other (docs/diff.md).
+struct KeySignal {
+    std::string name;  // "main-pipeline flow (truth)": the other run's signal of that name is drawn with it
+    std::string unit;  // the y axis: "L/min"
+    bool held = false;  // a command or a state, held until its next sample (drawn as steps)
+    std::vector<Point> points;  // (t in s, value), in time order
+};
+
 class System : public SystemJudge {
 public:
     // The case file's `system:` word.
@@ -108,6 +119,10 @@ public:
     // The world of one run of `spec`, one of this system's cases, with `seed`.
     // Throws (rig::ConfigError, std::runtime_error) when it cannot be built.
     virtual std::unique_ptr<SystemRun> plan_run(const CaseSpec& spec, std::uint64_t seed) const = 0;
+    // The signals that show what a run of this system did, from its trace
+    // alone, in the order they are drawn. A signal the trace holds no sample
+    // of is left out.
+    virtual std::vector<KeySignal> key_signals(const RecordedTrace& trace) const = 0;
 };
 
 }  // namespace rig::harness

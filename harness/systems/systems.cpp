@@ -68,4 +68,12 @@ CaseRun judge_trace(const RecordedTrace& trace) {
     return harness::judge_trace(trace, UnknownSystem("the trace's system '" + name + "' is not one this rig judges"));
 }
 
+std::vector<KeySignal> key_signals(const RecordedTrace& trace) {
+    const std::string name = trace.meta_or("system", std::string(kDefaultSystem));
+    for (const System* system : all_systems()) {
+        if (system->name() == name) return system->key_signals(trace);
+    }
+    throw std::runtime_error(trace.file.string() + ": the trace's system '" + name + "' is not one this rig knows");
+}
+
 }  // namespace rig::harness

@@ -4,7 +4,7 @@
 // new system is a folder beside these and a row in systems.cpp. And the three
 // things only the table can do: read a case file whole (its system's
 // sections by its `system:`), judge a trace (by its meta `system`), and name
-// the systems there are.
+// the systems there are, and say which signals of a trace show what its run did.
 #include <filesystem>
 #include <string_view>
 #include <vector>
@@ -37,5 +37,10 @@ CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& fil
 // naming a system this rig does not know is an error of the result, not an
 // exception. Never throws for a trace read_trace accepted.
 CaseRun judge_trace(const RecordedTrace& trace);
+
+// The key signals of a recorded trace (System::key_signals) of its system
+// (meta `system`, as judge_trace). Throws std::runtime_error for a trace of a
+// system this rig does not know, or whose samples lack what its system reads.
+std::vector<KeySignal> key_signals(const RecordedTrace& trace);
 
 }  // namespace rig::harness

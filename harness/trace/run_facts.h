@@ -39,8 +39,8 @@ struct RunFacts {
     std::vector<EmissionJitter> emission_jitter;
     nlohmann::json lateness;  // real time: the rig's own lateness against the case's bound; null in lockstep
     nlohmann::json board_io;  // a Modbus wire's frame counts (harness/session/board_attach.h); null without one
-    // The system's own facts (seed 001: the plant's refused duty commands, the
-    // frames each camera rendered), kept as written; an object.
+    // The system's own facts (seed 001: the frames each camera rendered, the
+    // duty commands a wired board's PWM capture published), kept as written; an object.
     nlohmann::json system = nlohmann::json::object();
 };
 

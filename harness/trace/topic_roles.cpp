@@ -10,10 +10,35 @@ bool starts_with(const std::string& text, const char* prefix) { return text.rfin
 
 }  // namespace
 
-bool rig_only_topic(const std::string& topic) { return starts_with(topic, "truth/") || starts_with(topic, "device/"); }
+TopicRole topic_role(const std::string& topic) {
+    if (starts_with(topic, "device/")) return TopicRole::device;
+    if (starts_with(topic, "truth/")) return TopicRole::truth;
+    if (starts_with(topic, "actuator/")) return TopicRole::actuator;
+    if (starts_with(topic, "controller/")) return TopicRole::controller;
+    if (starts_with(topic, "rig/clock/")) return TopicRole::clock;
+    return TopicRole::other;
+}
+
+std::string_view to_string(TopicRole role) {
+    switch (role) {
+        case TopicRole::device: return "device";
+        case TopicRole::truth: return "truth";
+        case TopicRole::actuator: return "actuator";
+        case TopicRole::controller: return "controller";
+        case TopicRole::clock: return "clock";
+        case TopicRole::other: break;
+    }
+    return "other";
+}
+
+bool rig_only_topic(const std::string& topic) {
+    const TopicRole role = topic_role(topic);
+    return role == TopicRole::truth || role == TopicRole::device;
+}
 
 bool controller_output_topic(const std::string& topic) {
-    return starts_with(topic, "actuator/") || starts_with(topic, "controller/");
+    const TopicRole role = topic_role(topic);
+    return role == TopicRole::actuator || role == TopicRole::controller;
 }
 
 std::optional<std::string> topic_role_violation(const std::string& endpoint, const std::string& topic) {

@@ -6,9 +6,18 @@
 // hold a run to these.
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rig::harness {
+
+// What a topic is for, by its name (the `role` of idl/topics.json): `rig diff`
+// tells a changed controller (its actuator commands or reports part first)
+// from a changed case or rig (the devices or the plant part first).
+enum class TopicRole { device, truth, actuator, controller, clock, other };
+TopicRole topic_role(const std::string& topic);
+// "device", "truth", "actuator", "controller", "clock", "other".
+std::string_view to_string(TopicRole role);
 
 // Topics only the rig may write (truth and device data). A sample on one of
 // them from another participant is forged.

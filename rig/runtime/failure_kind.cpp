@@ -12,6 +12,7 @@ constexpr std::pair<FailureKind, std::string_view> kFailureKindNames[] = {
     {FailureKind::startup_timeout, "startup_timeout"},
     {FailureKind::delivery_timeout, "delivery_timeout"},
     {FailureKind::topic_role_violation, "topic_role_violation"},
+    {FailureKind::malformed_command, "malformed_command"},
     {FailureKind::wire_unread, "wire_unread"},
     {FailureKind::wall_time_exceeded, "wall_time_exceeded"},
     {FailureKind::feedback_loop, "feedback_loop"},

@@ -16,6 +16,8 @@ enum class FailureKind {
     startup_timeout,       // discovery, hello or endpoint matching not done in time
     delivery_timeout,      // samples it published did not arrive in time
     topic_role_violation,  // a process read or wrote a topic its role forbids (truth, device, clock)
+    malformed_command,     // the plant got an actuator command it cannot act on (a duty per nozzle missing
+                           // or extra, NaN, out of range; a section the boom lacks): docs/controller-contract.md
     wire_unread,           // a bench wire's far end never took what the rig wrote on it
     wall_time_exceeded,    // the case ran past its wall-time bound
     feedback_loop,         // nodes kept answering each other at one instant

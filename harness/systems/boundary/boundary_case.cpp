@@ -75,10 +75,6 @@ BoundaryEdgeJudging read_edge(const YamlSection& s) {
     edge.probe.from_m = s.optional_in_range<double>("from_m", edge.probe.from_m, Bounds::closed(0, 1e5));
     edge.probe.to_m = s.optional_in_range<double>("to_m", edge.probe.to_m, Bounds::closed(-1, 1e5));
     edge.probe.spacing_m = s.optional_in_range<double>("spacing_m", edge.probe.spacing_m, Bounds::open_closed(0, 100));
-    edge.probe.search_inside_m =
-        s.optional_in_range<double>("search_inside_m", edge.probe.search_inside_m, Bounds::closed(0, 100));
-    edge.probe.search_outside_m =
-        s.optional_in_range<double>("search_outside_m", edge.probe.search_outside_m, Bounds::closed(0, 100));
     return edge;
 }
 

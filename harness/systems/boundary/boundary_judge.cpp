@@ -8,6 +8,7 @@
 #include "emulators/field2d/polygon.h"
 #include "harness/systems/boundary/boundary_figures.h"
 #include "idl/topics.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 namespace {
@@ -28,6 +29,23 @@ BoundaryEdge nearest_edge(const field2d::Polygon& area, field2d::Vec2 near) {
     const field2d::Vec2 a = v[best];
     const field2d::Vec2 b = v[(best + 1) % v.size()];
     return BoundaryEdge{a.east_m, a.north_m, b.east_m, b.north_m};
+}
+
+// delivered_l is what each nozzle delivered since the start: it never goes
+// back. Steps in which it does cannot say what was laid: an error naming the
+// sample, never a step's volume clamped to 0.
+void check_volumes_grow(const std::vector<NozzleStepTruth>& steps) {
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const NozzleStepTruth& step = steps[i];
+        for (std::size_t n = 0; n < step.delivered_l.size(); ++n) {
+            const double before = i == 0 || n >= steps[i - 1].delivered_l.size() ? 0.0 : steps[i - 1].delivered_l[n];
+            if (!std::isfinite(step.delivered_l[n]) || step.delivered_l[n] < before) {
+                throw std::runtime_error("truth/nozzles at t_ns " + std::to_string(step.t_ns) + ": nozzle " + std::to_string(n) +
+                                         " delivered_l " + shortest_text(step.delivered_l[n]) + " L after " +
+                                         shortest_text(before) + " L (it only grows)");
+            }
+        }
+    }
 }
 
 // A key of seed 001's part of the plan (meta `judging`, key `boundary`).
@@ -68,8 +86,6 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
                          {"from_m", e.probe.from_m},
                          {"to_m", e.probe.to_m},
                          {"spacing_m", e.probe.spacing_m},
-                         {"search_inside_m", e.probe.search_inside_m},
-                         {"search_outside_m", e.probe.search_outside_m},
                          {"wet_threshold_ul_cm2", e.probe.wet_threshold_ul_cm2}});
     }
     nlohmann::json table = nlohmann::json::array();
@@ -140,8 +156,8 @@ BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) 
             edge.probe.from_m = at(e, "from_m", "edges[].").get<double>();
             edge.probe.to_m = at(e, "to_m", "edges[].").get<double>();
             edge.probe.spacing_m = at(e, "spacing_m", "edges[].").get<double>();
-            edge.probe.search_inside_m = at(e, "search_inside_m", "edges[].").get<double>();
-            edge.probe.search_outside_m = at(e, "search_outside_m", "edges[].").get<double>();
+            // Plans written while the probe searched a +-2 m window carry
+            // search_inside_m and search_outside_m: the probe now spans the ground.
             edge.probe.wet_threshold_ul_cm2 = at(e, "wet_threshold_ul_cm2", "edges[].").get<double>();
             plan.edges.push_back(std::move(edge));
         }
@@ -215,10 +231,12 @@ std::vector<NozzleStepTruth> nozzle_step_truth(const RecordedTrace& trace) {
         steps.push_back(std::move(step));
     }
     std::stable_sort(steps.begin(), steps.end(), [](const NozzleStepTruth& a, const NozzleStepTruth& b) { return a.t_ns < b.t_ns; });
+    check_volumes_grow(steps);
     return steps;
 }
 
 std::vector<DoseRaster> ground_from_truth(const std::vector<NozzleStepTruth>& steps, const BoundaryJudgingPlan& plan) {
+    check_volumes_grow(steps);
     field2d::DepositionGrid2d grid(plan.ground);
     std::vector<double> previous(static_cast<std::size_t>(plan.ground.nozzle_count), 0.0);
     for (const NozzleStepTruth& step : steps) {
@@ -385,7 +403,7 @@ MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgi
                 doses.push_back(NAN);  // off the judge's ground grid
             }
         }
-        for (const auto& [name, value] : dose_by_cover_metrics(rois, doses)) metrics.values[name] = value;
+        for (const auto& [name, value] : dose_by_cover_metrics(rois, doses, metrics.not_measured)) metrics.values[name] = value;
     }
     if (!plan.papers.empty() || plan.dose_strip) {
         std::vector<DoseCells> papers;
@@ -395,7 +413,8 @@ MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgi
         }
         for (const auto& [name, value] : paper_metrics(papers, plan.coverage)) metrics.values[name] = value;
         if (plan.dose_strip) {
-            for (const auto& [name, value] : strip_metrics(dose_cells(*total, *plan.dose_strip, "dose_strip"), plan.coverage)) {
+            for (const auto& [name, value] :
+                 strip_metrics(dose_cells(*total, *plan.dose_strip, "dose_strip"), plan.coverage, metrics.not_measured)) {
                 metrics.values[name] = value;
             }
         }
@@ -404,16 +423,14 @@ MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgi
         const std::vector<DoseRaster> layers = ground_from_truth(steps, plan);
         const DoseRaster ground = sum_rasters(layers);
         for (const BoundaryEdgePlan& e : plan.edges) {
-            const EdgeProfile profile = wet_edge_profile(ground, e.edge, e.probe);
-            for (const auto& [name, value] : excess_metrics(e.metric, profile)) metrics.values[name] = value;
-            if (profile.excess_m.empty() || std::all_of(profile.excess_m.begin(), profile.excess_m.end(),
-                                                        [](double x) { return std::isnan(x); })) {
-                metrics.not_measured[e.metric + "_mean_m"] = "no wet ground at any station of the edge";
-                metrics.not_measured[e.metric + "_sd_m"] = "no wet ground at any station of the edge";
+            for (const auto& [name, value] : excess_metrics(e.metric, wet_edge_profile(ground, e.edge, e.probe), metrics.not_measured)) {
+                metrics.values[name] = value;
             }
             std::vector<EdgeProfile> per_nozzle;
             for (const DoseRaster& layer : layers) per_nozzle.push_back(wet_edge_profile(layer, e.edge, e.probe));
-            for (const auto& [name, value] : per_nozzle_excess_metrics(e.metric, per_nozzle)) metrics.values[name] = value;
+            for (const auto& [name, value] : per_nozzle_excess_metrics(e.metric, per_nozzle, metrics.not_measured)) {
+                metrics.values[name] = value;
+            }
         }
     }
     if (plan.centre_rule) {
@@ -430,13 +447,15 @@ MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgi
             }
             previous.resize(step.delivered_l.size(), 0.0);
             for (std::size_t n = 0; n < step.delivered_l.size(); ++n) {
-                sample.volume_l += std::max(0.0, step.delivered_l[n] - previous[n]);
+                sample.volume_l += step.delivered_l[n] - previous[n];  // >= 0: nozzle_step_truth checked
                 previous[n] = step.delivered_l[n];
             }
             samples.push_back(sample);
         }
-        for (const auto& [name, value] : centre_rule_metrics(samples, field2d::Polygon(plan.area, "target area")))
+        for (const auto& [name, value] :
+             centre_rule_metrics(samples, field2d::Polygon(plan.area, "target area"), metrics.not_measured)) {
             metrics.values[name] = value;
+        }
     }
     if (plan.flow_per_duty) {
         const field2d::NozzleFlowTable table(plan.flow_table);

@@ -66,10 +66,12 @@ struct NozzleStepTruth {
     std::vector<double> delivered_l;       // per nozzle, cumulative
 };
 // The samples of a trace, in time order. Throws std::runtime_error naming a
-// nozzles sample without a vehicle2d sample at its instant or a malformed one.
+// nozzles sample without a vehicle2d sample at its instant, a malformed one,
+// or one whose delivered_l went back.
 std::vector<NozzleStepTruth> nozzle_step_truth(const RecordedTrace& trace);
 
-// The ground per nozzle, rebuilt from the truth samples.
+// The ground per nozzle, rebuilt from the truth samples. Throws
+// std::runtime_error naming the sample where a nozzle's delivered_l went back.
 std::vector<DoseRaster> ground_from_truth(const std::vector<NozzleStepTruth>& steps, const BoundaryJudgingPlan& plan);
 // What each nozzle delivered at each duty it held (after flow_settle_s, over a
 // whole number of PWM periods).

@@ -3,12 +3,21 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The wet-edge probes lie on a lattice a quarter cell apart through this
+// distance outside the edge. The judge once searched only +-2 m from the edge,
+// from +2 m inward; anchoring the lattice there keeps every excess it measured
+// inside that window the same to the last bit.
+constexpr double kProbeLatticeOutsideM = 2.0;
 
 void check_raster(const DoseRaster& r, const char* who) {
     if (r.nx == 0 || r.ny == 0 || r.dose_ul_cm2.size() != r.nx * r.ny) {
@@ -58,10 +67,10 @@ EdgeProfile wet_edge_profile(const DoseRaster& raster, const BoundaryEdge& edge,
     if (!std::isfinite(length) || length < 1e-6) {
         throw std::invalid_argument("wet_edge_profile: the edge has no length (from == to) or is not finite");
     }
-    if (!(probe.spacing_m > 0.0) || !(probe.from_m >= 0.0) || !(probe.search_inside_m >= 0.0) ||
-        !(probe.search_outside_m >= 0.0) || !(probe.wet_threshold_ul_cm2 > 0.0) || !std::isfinite(probe.to_m)) {
+    if (!(probe.spacing_m > 0.0) || !(probe.from_m >= 0.0) || !(probe.wet_threshold_ul_cm2 > 0.0) ||
+        !std::isfinite(probe.to_m)) {
         throw std::invalid_argument(
-            "wet_edge_profile: probe needs spacing_m > 0, from_m >= 0, search distances >= 0, a wet threshold > 0 and a finite to_m");
+            "wet_edge_profile: probe needs spacing_m > 0, from_m >= 0, a wet threshold > 0 and a finite to_m");
     }
     const double to_m = probe.to_m < 0.0 ? length : probe.to_m;
     // Along the edge u; the outside (right of u) n.
@@ -70,36 +79,75 @@ EdgeProfile wet_edge_profile(const DoseRaster& raster, const BoundaryEdge& edge,
     const double ne = un;
     const double nn = -ue;
     const double step = raster.cell_m / 4.0;
-    const auto wet = [&](double e, double n) {
+    const double east_end = raster.east0_m + raster.cell_m * static_cast<double>(raster.nx);
+    const double north_end = raster.north0_m + raster.cell_m * static_cast<double>(raster.ny);
+    // The cell under a point, or none off the ground.
+    const auto cell = [&](double e, double n) -> std::optional<std::size_t> {
         const double fx = std::floor((e - raster.east0_m) / raster.cell_m);
         const double fy = std::floor((n - raster.north0_m) / raster.cell_m);
-        if (fx < 0.0 || fy < 0.0 || fx >= static_cast<double>(raster.nx) || fy >= static_cast<double>(raster.ny)) {
-            return false;
+        if (!(fx >= 0.0 && fy >= 0.0 && fx < static_cast<double>(raster.nx) && fy < static_cast<double>(raster.ny))) {
+            return std::nullopt;
         }
-        return raster.dose_ul_cm2[static_cast<std::size_t>(fy) * raster.nx + static_cast<std::size_t>(fx)] >=
-               probe.wet_threshold_ul_cm2;
+        return static_cast<std::size_t>(fy) * raster.nx + static_cast<std::size_t>(fx);
     };
     EdgeProfile profile;
     if (to_m < probe.from_m) return profile;
     const auto stations = static_cast<std::size_t>(std::floor((to_m - probe.from_m) / probe.spacing_m + 1e-9)) + 1;
-    const auto probes = static_cast<std::size_t>(std::ceil((probe.search_inside_m + probe.search_outside_m) / step));
     for (std::size_t k = 0; k < stations; ++k) {
         const double s = probe.from_m + static_cast<double>(k) * probe.spacing_m;
         const double pe = edge.from_east_m + s * ue;
         const double pn = edge.from_north_m + s * un;
+        // Where the probe's line crosses the ground: d in [d_in, d_out] (slabs
+        // of a rectangle; the cell test below has the last word at its borders).
+        double d_in = -INFINITY;
+        double d_out = INFINITY;
+        const auto slab = [&](double p, double dir, double lo, double hi) {
+            if (dir == 0.0) {
+                if (p < lo || p > hi) d_in = INFINITY;
+                return;
+            }
+            const double a = (lo - p) / dir;
+            const double b = (hi - p) / dir;
+            d_in = std::max(d_in, std::min(a, b));
+            d_out = std::min(d_out, std::max(a, b));
+        };
+        slab(pe, ne, raster.east0_m, east_end);
+        slab(pn, nn, raster.north0_m, north_end);
         double excess = kNaN;
-        // From the outer end inward: the first wet point is the outermost. The
-        // wet edge lies between it and the dry probe before it: take the middle
-        // (within step / 2 = an eighth of a cell of the edge along the probe).
-        for (std::size_t j = 0; j <= probes; ++j) {
-            const double d = std::max(-probe.search_inside_m, probe.search_outside_m - static_cast<double>(j) * step);
-            if (wet(pe + d * ne, pn + d * nn)) {
-                excess = j == 0 ? d : d + 0.5 * step;
+        double at_least = kNaN;
+        StationFinding finding = StationFinding::off_ground;
+        if (d_in <= d_out) {
+            // Probes at d = kProbeLatticeOutsideM - j step, from the ground's
+            // outer end inward: the first wet one is the outermost. The wet edge
+            // lies between it and the dry probe before it: take the middle
+            // (within step / 2 = an eighth of a cell of the edge along the probe).
+            // Wet at the first probe on the ground: the edge lies past the ground's end.
+            const auto j_first = static_cast<long>(std::floor((kProbeLatticeOutsideM - d_out) / step)) - 1;
+            const auto j_last = static_cast<long>(std::ceil((kProbeLatticeOutsideM - d_in) / step)) + 1;
+            for (long j = j_first; j <= j_last; ++j) {
+                const double d = kProbeLatticeOutsideM - static_cast<double>(j) * step;
+                const std::optional<std::size_t> at = cell(pe + d * ne, pn + d * nn);
+                if (!at) {
+                    if (finding == StationFinding::off_ground) continue;  // not on the ground yet
+                    break;                                                // past its inner end
+                }
+                const bool first_on_ground = finding == StationFinding::off_ground;
+                finding = StationFinding::dry;
+                if (raster.dose_ul_cm2[*at] < probe.wet_threshold_ul_cm2) continue;
+                if (first_on_ground) {
+                    finding = StationFinding::wet_to_ground_end;
+                    at_least = d;
+                } else {
+                    finding = StationFinding::wet_edge;
+                    excess = d + 0.5 * step;
+                }
                 break;
             }
         }
         profile.station_m.push_back(s);
         profile.excess_m.push_back(excess);
+        profile.finding.push_back(finding);
+        profile.at_least_m.push_back(at_least);
     }
     return profile;
 }
@@ -133,27 +181,92 @@ Summary summarize(const std::vector<double>& values) {
     return s;
 }
 
-std::map<std::string, double> excess_metrics(const std::string& prefix, const EdgeProfile& profile) {
+namespace {
+
+// Why a summary over a profile's stations is not the edge's value: stations
+// wet to the judged ground's end, or off it. Empty when every station is a
+// wet edge or dry.
+std::string unknown_stations_reason(const EdgeProfile& profile) {
+    std::size_t beyond = 0;
+    std::size_t off = 0;
+    double least = INFINITY;
+    for (std::size_t i = 0; i < profile.finding.size(); ++i) {
+        if (profile.finding[i] == StationFinding::wet_to_ground_end) {
+            ++beyond;
+            least = std::min(least, profile.at_least_m[i]);
+        } else if (profile.finding[i] == StationFinding::off_ground) {
+            ++off;
+        }
+    }
+    const std::string of = " of " + std::to_string(profile.finding.size()) + " stations";
+    std::string reason;
+    if (beyond > 0) {
+        reason = "wet to the end of the judged ground (judge.ground) at " + std::to_string(beyond) + of +
+                 ": the wet edge lies beyond it, at least " + fixed_text(least, 3) +
+                 " m past the boundary (+ outside); a larger ground would measure it";
+    }
+    if (off > 0) {
+        reason += (reason.empty() ? "" : "; ") + std::to_string(off) + of +
+                  " probe off the judged ground (judge.ground does not reach them)";
+    }
+    return reason;
+}
+
+// The smallest excess known for every station: the measured minimum, when no
+// station wet to the ground's end could lie below it and none is off the ground.
+std::optional<double> known_min(const EdgeProfile& profile, const Summary& measured) {
+    if (measured.n == 0) return std::nullopt;
+    for (std::size_t i = 0; i < profile.finding.size(); ++i) {
+        if (profile.finding[i] == StationFinding::off_ground) return std::nullopt;
+        if (profile.finding[i] == StationFinding::wet_to_ground_end && profile.at_least_m[i] < measured.min) {
+            return std::nullopt;
+        }
+    }
+    return measured.min;
+}
+
+}  // namespace
+
+std::map<std::string, double> excess_metrics(const std::string& prefix, const EdgeProfile& profile,
+                                             std::map<std::string, std::string>& not_measured) {
     std::map<std::string, double> m;
     const Summary s = summarize(profile.excess_m);
+    const auto dry = static_cast<std::size_t>(
+        std::count(profile.finding.begin(), profile.finding.end(), StationFinding::dry));
     m[prefix + "_stations"] = static_cast<double>(s.n);
-    m[prefix + "_stations_dry"] = static_cast<double>(profile.excess_m.size() - s.n);
-    if (s.n > 0) {
-        m[prefix + "_mean_m"] = s.mean;
-        m[prefix + "_min_m"] = s.min;
-        m[prefix + "_max_m"] = s.max;
+    m[prefix + "_stations_dry"] = static_cast<double>(dry);
+    if (const std::string unknown = unknown_stations_reason(profile); !unknown.empty()) {
+        for (const char* name : {"_mean_m", "_sd_m", "_max_m"}) not_measured[prefix + name] = unknown;
+        if (const std::optional<double> min = known_min(profile, s)) {
+            m[prefix + "_min_m"] = *min;
+        } else {
+            not_measured[prefix + "_min_m"] = unknown;
+        }
+        return m;
     }
+    if (s.n == 0) {
+        not_measured[prefix + "_mean_m"] = "no wet ground at any station of the edge";
+        not_measured[prefix + "_sd_m"] = "no wet ground at any station of the edge";
+        return m;
+    }
+    m[prefix + "_mean_m"] = s.mean;
+    m[prefix + "_min_m"] = s.min;
+    m[prefix + "_max_m"] = s.max;
     if (s.n > 1) m[prefix + "_sd_m"] = s.sd;
     return m;
 }
 
-std::map<std::string, double> per_nozzle_excess_metrics(const std::string& prefix,
-                                                        const std::vector<EdgeProfile>& per_nozzle) {
+std::map<std::string, double> per_nozzle_excess_metrics(const std::string& prefix, const std::vector<EdgeProfile>& per_nozzle,
+                                                        std::map<std::string, std::string>& not_measured) {
     std::map<std::string, double> m;
     for (std::size_t i = 0; i < per_nozzle.size(); ++i) {
         const std::string p = prefix + "_nozzle" + std::to_string(i);
         const Summary s = summarize(per_nozzle[i].excess_m);
         m[p + "_stations"] = static_cast<double>(s.n);
+        if (const std::string unknown = unknown_stations_reason(per_nozzle[i]); !unknown.empty()) {
+            for (const char* name : {"_mean_m", "_sd_m", "_max_m"}) not_measured[p + name] = unknown;
+            continue;
+        }
         if (s.n > 0) {
             m[p + "_mean_m"] = s.mean;
             m[p + "_max_m"] = s.max;
@@ -266,8 +379,8 @@ std::map<std::string, double> eq13_fit_metrics(const std::vector<FlowCheckRow>& 
     return m;
 }
 
-std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples,
-                                                  const field2d::Polygon& area) {
+std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples, const field2d::Polygon& area,
+                                                  std::map<std::string, std::string>& not_measured) {
     double crossings = 0.0;
     double out_samples = 0.0;
     double spray_l = 0.0;
@@ -308,11 +421,19 @@ std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSa
             }
         }
     }
-    return {{"centre_out_crossings", crossings},
-            {"centre_out_samples", out_samples},
-            {"centre_out_spray_ml", spray_l * 1000.0},
-            {"centre_out_close_s", longest_s},
-            {"centre_out_close_m", longest_m}};
+    std::map<std::string, double> m = {{"centre_out_crossings", crossings},
+                                       {"centre_out_samples", out_samples},
+                                       {"centre_out_spray_ml", spray_l * 1000.0}};
+    if (crossings == 0.0) {
+        // No spell outside: no time to close in. A 0 would read as a rule obeyed.
+        const char* why = "the boom centre never left the target area: the rule was never put to the test";
+        not_measured["centre_out_close_s"] = why;
+        not_measured["centre_out_close_m"] = why;
+    } else {
+        m["centre_out_close_s"] = longest_s;
+        m["centre_out_close_m"] = longest_m;
+    }
+    return m;
 }
 
 }  // namespace rig::harness

@@ -8,9 +8,12 @@
 // "every 0.5 m"), the ground is probed along the edge's outward normal; the
 // station's excess is the signed distance of the outermost wet point from the
 // edge, positive outside the area (spray past the boundary), negative when the
-// spray stops short of it; NaN when nothing along the probe is wet (the boom
-// never reached that station). The probe steps a quarter cell; the edge is
-// taken halfway between the outermost wet probe and the dry one beyond it.
+// spray stops short of it. The probe runs across the whole judged ground (the
+// raster: the case's judge.ground), inside and outside, in steps of a quarter
+// cell; the edge is taken halfway between the outermost wet probe and the dry
+// one beyond it. Where the ground ends the probe ends: a station wet up to the
+// ground's outer end has no measured excess, only "at least" the distance of
+// that end (docs/metrics.md "Windows and ends").
 // The same measure gives, on different runs,
 //   boundary_overrun_*   driving along the edge (Table 7; Table 8 "along");
 //   drive_out_excess_*   driving out of the area across the edge (Table 8);
@@ -58,16 +61,24 @@ struct EdgeProbe {
     double from_m = 0.0;              // first station, along the edge from `from`, >= 0
     double to_m = -1.0;               // last station at or before this; < 0: the edge's length
     double spacing_m = 0.5;           // > 0; Table 7 / 8: every 0.5 m
-    double search_inside_m = 2.0;     // >= 0; how far inside the probe starts
-    double search_outside_m = 2.0;    // >= 0; how far outside it ends (an excess equal to it: at least that far)
     // Wet: a dose at or above this. Assumed: 0.05 uL/cm^2 (5 L/ha), a tenth of
     // what one nozzle leaves in one pass at 1.5 m/s (0.61 L/min over a 1.43 m fan).
     double wet_threshold_ul_cm2 = 0.05;
 };
 
+// What one station's probe found on the judged ground.
+enum class StationFinding {
+    wet_edge,           // the wet ground ends on the ground: excess_m holds where
+    dry,                // nothing wet on the ground along the probe (the boom never sprayed there)
+    wet_to_ground_end,  // wet up to the ground's outer end: the edge lies beyond it, at_least_m says how far at least
+    off_ground,         // the probe's line does not cross the judged ground
+};
+
 struct EdgeProfile {
-    std::vector<double> station_m;   // along the edge
-    std::vector<double> excess_m;    // signed, + outside; NaN: nothing wet on that probe
+    std::vector<double> station_m;             // along the edge
+    std::vector<double> excess_m;              // signed, + outside; NaN unless the finding is wet_edge
+    std::vector<StationFinding> finding;
+    std::vector<double> at_least_m;            // wet_to_ground_end: the last wet probe (signed, + outside); NaN otherwise
 };
 
 // Throws std::invalid_argument for a bad raster (size, cell), a zero-length
@@ -85,13 +96,20 @@ struct Summary {
 Summary summarize(const std::vector<double>& values);
 
 // prefix_mean_m, prefix_sd_m, prefix_min_m, prefix_max_m, prefix_stations (n
-// measured), prefix_stations_dry (NaN stations). With no wet station the
-// mean/sd/min/max are absent (a limit on them then fails as missing).
-std::map<std::string, double> excess_metrics(const std::string& prefix, const EdgeProfile& profile);
+// measured), prefix_stations_dry (dry stations). With no wet station the
+// mean/sd/min/max are absent, and mean and sd not measured ("no wet ground").
+// A station wet to the ground's end or off it has no value: then the mean, sd
+// and max are not measured, naming how many and how far at least (a mean over
+// the other stations would pass a bound off as the edge's value), and the min
+// only where a measured station lies at or below every such bound. Metrics
+// without a value go to `not_measured` with why.
+std::map<std::string, double> excess_metrics(const std::string& prefix, const EdgeProfile& profile,
+                                             std::map<std::string, std::string>& not_measured);
 // Per nozzle: prefix_nozzle<i>_mean_m, _sd_m, _max_m, _stations, from each
-// nozzle's own layer's profile (index = nozzle number).
-std::map<std::string, double> per_nozzle_excess_metrics(const std::string& prefix,
-                                                        const std::vector<EdgeProfile>& per_nozzle);
+// nozzle's own layer's profile (index = nozzle number); a nozzle's stations
+// wet to the ground's end or off it leave its mean, sd and max not measured.
+std::map<std::string, double> per_nozzle_excess_metrics(const std::string& prefix, const std::vector<EdgeProfile>& per_nozzle,
+                                                        std::map<std::string, std::string>& not_measured);
 
 // ---------------------------------------------------------------- the boom-centre rule (Sec. 4.2, Table 8 "along")
 
@@ -113,11 +131,12 @@ struct CentreRuleSample {
 // centre_out_close_s / centre_out_close_m: over the spells outside, the
 // longest time, and the centre's travel over it, from leaving the area to the
 // last sample that delivered anything (0 when nothing was delivered outside);
-// centre_out_samples: samples with the centre outside. Throws
-// std::invalid_argument naming the sample for a non-finite value, a negative
-// volume or time going back.
-std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples,
-                                                  const field2d::Polygon& area);
+// not measured when the centre never left the area (the rule was never put to
+// the test: 0 would read as a rule obeyed); centre_out_samples: samples with
+// the centre outside. Throws std::invalid_argument naming the sample for a
+// non-finite value, a negative volume or time going back.
+std::map<std::string, double> centre_rule_metrics(const std::vector<CentreRuleSample>& samples, const field2d::Polygon& area,
+                                                  std::map<std::string, std::string>& not_measured);
 
 // ---------------------------------------------------------------- flow per duty (Table 3)
 

@@ -64,7 +64,6 @@ public:
     std::vector<Node*> nodes() override { return all_; }
 
     void finish(TraceFile& trace, RunFacts& facts, const std::filesystem::path& case_dir) override {
-        facts.system["plant_rejected_duty_commands"] = plant_.rejected_commands();
         nlohmann::json report_frames = nlohmann::json::array();
         for (std::size_t c = 0; c < cameras_.size(); ++c) {
             facts.system[cameras_[c]->name() + "_frames"] = cameras_[c]->frames_rendered();
@@ -147,6 +146,29 @@ std::string job_yaml(const BoundarySections& own) {
            out.c_str() + "\n";
 }
 
+// The duty the controller commanded per nozzle (Sec. 3.2.1's PWM), held from
+// one command to the next: where the boundary shut-off and the rate show.
+std::vector<KeySignal> boundary_key_signals(const RecordedTrace& trace) {
+    std::vector<KeySignal> signals;
+    for (const RecordedSample& sample : trace.samples(topics::kNozzlePwm)) {
+        const auto duties = sample.json.find("duty_pct");
+        if (duties == sample.json.end() || !duties->is_array()) continue;
+        for (std::size_t nozzle = 0; nozzle < duties->size(); ++nozzle) {
+            if (!(*duties)[nozzle].is_number()) continue;
+            if (signals.size() <= nozzle) signals.resize(nozzle + 1);
+            signals[nozzle].points.push_back({ns_to_seconds(sample.t_ns), (*duties)[nozzle].get<double>()});
+        }
+    }
+    for (std::size_t nozzle = 0; nozzle < signals.size(); ++nozzle) {
+        signals[nozzle].name = "nozzle " + std::to_string(nozzle) + " duty (commanded)";
+        signals[nozzle].unit = "%";
+        signals[nozzle].held = true;
+    }
+    // A nozzle no command named is not a signal of this run.
+    std::erase_if(signals, [](const KeySignal& signal) { return signal.points.empty(); });
+    return signals;
+}
+
 class BoundaryRun final : public SystemRun {
 public:
     BoundaryRun(const CaseSpec& spec, std::uint64_t seed)
@@ -216,6 +238,8 @@ public:
         if (!plan.is_object() || !plan.contains("boundary")) throw std::runtime_error("judging plan: no key boundary");
         return judge_boundary_trace(trace, boundary_judging_plan_from_json(plan.at("boundary")));
     }
+
+    std::vector<KeySignal> key_signals(const RecordedTrace& trace) const override { return boundary_key_signals(trace); }
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "emulators/malformed_command.h"
 #include "harness/trace/sha256.h"
 #include "idl/topics.h"
 #include "rig/camera/png_file.h"
@@ -107,18 +108,16 @@ TimeNs BoundaryPlantNode::step(TimeNs now_ns) {
         }
     }
     for (const msg::NozzlePwm& pwm : duty_reader_->take_all()) {
+        // A duty missing or extra, NaN or outside 0-100 % is no command the
+        // valves can carry out: the run ends on it, never on a clamped guess.
+        if (const auto problem = emulators::nozzle_pwm_problem(pwm, valves_.nozzle_count())) {
+            throw emulators::malformed_command(topics::kNozzlePwm, now_ns, *problem);
+        }
         const std::vector<double>& duty = pwm.duty_pct();
-        if (duty.size() > commanded_pct_.size()) ++rejected_commands_;
-        for (std::size_t n = 0; n < std::min(duty.size(), commanded_pct_.size()); ++n) {
-            double value = duty[n];
-            if (!std::isfinite(value) || value < 0.0 || value > 100.0) {
-                // A driver stage cannot do more than always on or always off.
-                ++rejected_commands_;
-                value = std::isfinite(value) ? std::clamp(value, 0.0, 100.0) : 0.0;
-            }
-            if (value != commanded_pct_[n]) {
-                valves_.command(static_cast<int>(n), value, now_ns);
-                commanded_pct_[n] = value;
+        for (std::size_t n = 0; n < commanded_pct_.size(); ++n) {
+            if (duty[n] != commanded_pct_[n]) {
+                valves_.command(static_cast<int>(n), duty[n], now_ns);
+                commanded_pct_[n] = duty[n];
             }
         }
     }

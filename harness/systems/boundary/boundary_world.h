@@ -2,7 +2,8 @@
 // Seed 001's world for one run of a boundary case (harness/systems/boundary/boundary_case.h):
 // the sprayer's 2-D kinematics, and the rig's local nodes that the lockstep
 // master steps each instant, in this order:
-//   BoundaryPlantNode  takes the controller's PWM duties (actuator/nozzle_pwm/duty),
+//   BoundaryPlantNode  takes the controller's PWM duties (actuator/nozzle_pwm/duty;
+//                      a malformed one ends the run, emulators/malformed_command.h),
 //                      runs the six valves on the deposition step grid and
 //                      publishes the truth the judge rebuilds the ground from
 //                      (truth/vehicle2d, truth/nozzles);
@@ -63,9 +64,6 @@ public:
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
     bool has_unread_input() const override { return duty_reader_->has_unread(); }
-    // Duty commands the plant could not take (outside [0, 100] %, not finite,
-    // more nozzles than the boom has): clamped or dropped, counted here.
-    std::uint64_t rejected_commands() const { return rejected_commands_; }
 
 private:
     void publish_truth(TimeNs mid_ns);
@@ -79,7 +77,6 @@ private:
     TimeNs idle_period_ns_ = 0;
     TimeNs next_idle_truth_ns_ = 0;
     std::vector<double> commanded_pct_;
-    std::uint64_t rejected_commands_ = 0;
     std::unique_ptr<Reader<msg::NozzlePwm>> duty_reader_;
     std::unique_ptr<Writer<msg::Vehicle2dTruth>> vehicle_writer_;
     std::unique_ptr<Writer<msg::NozzlesTruth>> nozzles_writer_;

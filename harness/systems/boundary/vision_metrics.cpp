@@ -134,26 +134,41 @@ std::map<std::string, double> vision_metrics(const std::vector<RoiJudged>& rois,
 }
 
 std::map<std::string, double> dose_by_cover_metrics(const std::vector<RoiJudged>& rois,
-                                                    const std::vector<double>& dose_ul_cm2) {
+                                                    const std::vector<double>& dose_ul_cm2,
+                                                    std::map<std::string, std::string>& not_measured) {
     if (dose_ul_cm2.size() != rois.size()) throw std::invalid_argument("dose by cover: one dose per ROI");
     // Sec. 5.2 classes areas by the computed density: sparse below 40 %, normal above.
     constexpr double kSparseBelow = 0.40;
-    double sparse_sum = 0.0, normal_sum = 0.0;
-    std::size_t sparse = 0, normal = 0;
+    struct CoverClass {
+        const char* name;
+        double sum = 0.0;
+        std::size_t rois = 0;
+        std::size_t off_ground = 0;
+    };
+    CoverClass sparse{"sparse"};
+    CoverClass normal{"normal"};
     for (std::size_t i = 0; i < rois.size(); ++i) {
-        if (!std::isfinite(dose_ul_cm2[i])) continue;
-        if (rois[i].true_density < kSparseBelow) {
-            sparse_sum += dose_ul_cm2[i];
-            ++sparse;
+        CoverClass& of = rois[i].true_density < kSparseBelow ? sparse : normal;
+        ++of.rois;
+        if (std::isfinite(dose_ul_cm2[i])) {
+            of.sum += dose_ul_cm2[i];
         } else {
-            normal_sum += dose_ul_cm2[i];
-            ++normal;
+            ++of.off_ground;
         }
     }
-    std::map<std::string, double> out{{"vision_sparse_rois_count", static_cast<double>(sparse)},
-                                      {"vision_normal_rois_count", static_cast<double>(normal)}};
-    if (sparse > 0) out["vision_dose_sparse_rois_ul_cm2"] = sparse_sum / static_cast<double>(sparse);
-    if (normal > 0) out["vision_dose_normal_rois_ul_cm2"] = normal_sum / static_cast<double>(normal);
+    std::map<std::string, double> out;
+    for (const CoverClass& of : {sparse, normal}) {
+        const std::string prefix = std::string("vision_") + of.name;
+        out[prefix + "_rois_count"] = static_cast<double>(of.rois);
+        const std::string mean = "vision_dose_" + std::string(of.name) + "_rois_ul_cm2";
+        if (of.off_ground > 0) {
+            // A mean over the others would be another set's mean, passed off as this one's.
+            not_measured[mean] = std::to_string(of.off_ground) + " of the " + std::to_string(of.rois) + " " + of.name +
+                                     " ROIs' squares reach off the judged ground (judge.ground): their dose is unknown";
+        } else if (of.rois > 0) {
+            out[mean] = of.sum / static_cast<double>(of.rois);
+        }
+    }
     return out;
 }
 
@@ -188,7 +203,8 @@ std::map<std::string, double> paper_metrics(const std::vector<DoseCells>& papers
     return out;
 }
 
-std::map<std::string, double> strip_metrics(const DoseCells& strip, const CoverageModel& model) {
+std::map<std::string, double> strip_metrics(const DoseCells& strip, const CoverageModel& model,
+                                            std::map<std::string, std::string>& not_measured) {
     std::map<std::string, double> out;
     const std::vector<double>& cells = strip.dose_ul_cm2;
     if (cells.empty()) throw std::invalid_argument("dose strip: no ground cell lies inside it");
@@ -202,7 +218,14 @@ std::map<std::string, double> strip_metrics(const DoseCells& strip, const Covera
     double squares = 0.0;
     for (const double d : cells) squares += (d - mean) * (d - mean);
     out["strip_dose_mean_ul_cm2"] = mean;
-    out["strip_dose_cv_pct"] = mean > 0.0 && cells.size() > 1 ? 100.0 * std::sqrt(squares / (n - 1.0)) / mean : 0.0;
+    // A spread over nothing laid, or over one cell, is no evenness: not a CV of 0.
+    if (!(mean > 0.0)) {
+        not_measured["strip_dose_cv_pct"] = "nothing was laid on the strip";
+    } else if (cells.size() < 2) {
+        not_measured["strip_dose_cv_pct"] = "the strip holds one ground cell: no spread to measure";
+    } else {
+        out["strip_dose_cv_pct"] = 100.0 * std::sqrt(squares / (n - 1.0)) / mean;
+    }
     out["strip_coverage_mean_pct"] = 100.0 * coverage / n;
     return out;
 }

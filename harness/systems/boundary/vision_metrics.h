@@ -121,12 +121,14 @@ std::map<std::string, double> vision_metrics(const std::vector<RoiJudged>& rois,
 // rois[i]; NaN where the ground grid has none), averaged over the ROIs whose
 // true cover is below Sec. 5.2's 40 % split (sparse) and at or above it
 // (normal): vision_dose_sparse_rois_ul_cm2, vision_dose_normal_rois_ul_cm2,
-// and their counts vision_sparse_rois_count, vision_normal_rois_count. The
+// and their counts vision_sparse_rois_count, vision_normal_rois_count. A
+// class with a ROI off the ground (NaN) has its mean not measured. The
 // ground under a ROI is sprayed after the frame that saw it (0.13-0.4 s at
 // 1.5 m/s), by whatever level the frames then in force chose: across a cover
 // edge the two differ, the spatial offset S7 asks to report.
 std::map<std::string, double> dose_by_cover_metrics(const std::vector<RoiJudged>& rois,
-                                                    const std::vector<double>& dose_ul_cm2);
+                                                    const std::vector<double>& dose_ul_cm2,
+                                                    std::map<std::string, std::string>& not_measured);
 
 // A ground rectangle (local frame, m): a water-sensitive paper or the strip
 // whose dose per area is judged.
@@ -154,7 +156,9 @@ struct DoseCells {
 std::map<std::string, double> paper_metrics(const std::vector<DoseCells>& papers, const CoverageModel& model);
 // Dose per area over a strip (Sec. 3's u, the dose the levels aim at):
 // strip_dose_mean_ul_cm2, strip_dose_cv_pct (the spread along and across
-// travel: PWM pulses at 9 Hz lay stripes every v / 9 m), strip_coverage_mean_pct.
-std::map<std::string, double> strip_metrics(const DoseCells& strip, const CoverageModel& model);
+// travel: PWM pulses at 9 Hz lay stripes every v / 9 m; not measured over a
+// strip with nothing laid or a single cell), strip_coverage_mean_pct.
+std::map<std::string, double> strip_metrics(const DoseCells& strip, const CoverageModel& model,
+                                            std::map<std::string, std::string>& not_measured);
 
 }  // namespace rig::harness

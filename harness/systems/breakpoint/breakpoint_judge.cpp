@@ -11,6 +11,7 @@
 #include "harness/systems/breakpoint/breakpoint_figures.h"
 #include "harness/systems/breakpoint/gnss_wire_faults.h"
 #include "idl/topics.h"
+#include "rig/text/number_text.h"
 
 namespace rig::harness {
 
@@ -229,6 +230,7 @@ DoseProfile dose_profile(const RecordedTrace& trace) {
         throw std::runtime_error("trace " + trace.file.string() + ": meta deposition_grid: " + parse_error.what());
     }
     const auto rows = params.at("rows").get<std::size_t>();
+    profile.ground_rows = rows;
     const int nozzles = params.at("nozzle_count").get<int>();
     const int passes = params.at("passes").get<int>();
     std::vector<std::vector<double>> sums(static_cast<std::size_t>(std::max(passes, 0)), std::vector<double>(rows, 0.0));
@@ -274,6 +276,10 @@ SystemJudgement judge_breakpoint_trace(const RecordedTrace& trace, const Breakpo
             if (plan.judge_breakpoint && open_at_m) {
                 // Where the flow adjustment began, before the breakpoint (paper: 1.70 / 2.55 / 3.45 m).
                 metrics.values["flow_adjust_start_before_breakpoint_m"] = plan.breakpoint_along_m - *open_at_m;
+            } else if (plan.judge_breakpoint) {
+                metrics.not_measured["flow_adjust_start_before_breakpoint_m"] =
+                    "the sections opened at " + fixed_text(ns_to_seconds(*flow.first_open_ns), 3) +
+                    " s, where truth has no position of the nozzle line: " + track.describe_span();
             }
             add_flow_figure(trace, track, *flow.first_open_ns, plan.flow_window.to_ns, plan.breakpoint_along_m,
                             *figures);

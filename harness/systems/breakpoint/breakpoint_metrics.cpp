@@ -29,9 +29,10 @@ std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const {
     const auto after = std::lower_bound(samples_.begin(), samples_.end(), t,
                                         [](const VehicleSample& sample, TimeNs at) { return sample.t_ns < at; });
     if (after != samples_.end() && after->t_ns == t) return after->nozzle_line_along_m;
-    if (after == samples_.begin()) return after->nozzle_line_along_m;  // before the first sample: standing there
+    // Before the first sample or after the last, truth does not say where the
+    // nozzle line was: no position, never the nearest one held.
+    if (after == samples_.begin() || after == samples_.end()) return std::nullopt;
     const VehicleSample& before = *std::prev(after);
-    if (after == samples_.end()) return before.nozzle_line_along_m;  // after the last: where it stood
     // Across a headland turn the two neighbours are on different passes: the
     // vehicle was on `before`'s pass until the reposition, which the truth
     // stream dates to its first sample of the new pass at the latest.
@@ -39,6 +40,12 @@ std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const {
     const double fraction =
         static_cast<double>(t - before.t_ns) / static_cast<double>(after->t_ns - before.t_ns);
     return before.nozzle_line_along_m + fraction * (after->nozzle_line_along_m - before.nozzle_line_along_m);
+}
+
+std::string VehicleTrack::describe_span() const {
+    if (samples_.empty()) return "no vehicle truth was recorded";
+    return "the vehicle truth recorded spans " + seconds_text(samples_.front().t_ns) + " to " +
+           seconds_text(samples_.back().t_ns);
 }
 
 std::optional<TimeNs> VehicleTrack::pass_start_ns(int pass_index) const {
@@ -67,6 +74,11 @@ MetricSet breakpoint_metrics(const std::vector<BreakpointEventSample>& events, c
                 metrics.values["breakpoint_error_signed_m"] = *nozzle_along_m - breakpoint_along_m;
                 metrics.values["breakpoint_error_m"] = std::abs(*nozzle_along_m - breakpoint_along_m);
                 metrics.values["breakpoint_reached_at_s"] = ns_to_seconds(event.t_ns);
+            } else {
+                const std::string why = "declared at " + seconds_text(event.t_ns) +
+                                        ", where truth has no position of the nozzle line: " + track.describe_span();
+                metrics.not_measured["breakpoint_error_m"] = why;
+                metrics.not_measured["breakpoint_error_signed_m"] = why;
             }
         }
     }
@@ -506,9 +518,12 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
     }
     // Missed: rows of the strip the case says must be sprayed that neither pass
     // sprayed, whatever the controller did (a row belongs to the strip when its
-    // centre does). Rows outside the grid count as unsprayed.
+    // centre does). A strip row the recorded ground has no row for is unknown
+    // ground, neither sprayed nor missed: then missed_m is not measured.
     double missed_m = 0.0;
     std::optional<double> gap_from_m;
+    long off_ground_rows = 0;
+    const std::size_t ground_rows = std::max(rows, profile.ground_rows);
     const auto strip_rows = static_cast<long>(
         std::floor((judging.strip_to_m - judging.strip_from_m) / profile.row_m + 1e-9));
     const long first_strip_row =
@@ -517,9 +532,12 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
         const long row = first_strip_row + k;
         const double centre_m = profile.first_row_centre_m + static_cast<double>(row) * profile.row_m;
         if (centre_m > judging.strip_to_m + 1e-9) break;
-        const bool covered = row >= 0 && static_cast<std::size_t>(row) < rows &&
-                             (sprayed(profile.first_pass, static_cast<std::size_t>(row)) ||
-                              sprayed(profile.continuation, static_cast<std::size_t>(row)));
+        if (row < 0 || static_cast<std::size_t>(row) >= ground_rows) {
+            ++off_ground_rows;
+            continue;
+        }
+        const bool covered = sprayed(profile.first_pass, static_cast<std::size_t>(row)) ||
+                             sprayed(profile.continuation, static_cast<std::size_t>(row));
         if (!covered) {
             missed_m += profile.row_m;
             if (!gap_from_m) gap_from_m = centre_m - 0.5 * profile.row_m;
@@ -530,7 +548,17 @@ DepositionResult deposition_metrics(const DoseProfile& profile, const Deposition
     }
     if (gap_from_m) result.areas.push_back({"missed", *gap_from_m, judging.strip_to_m});
     metrics.values["overlap_m"] = overlap_m;
-    metrics.values["missed_m"] = missed_m;
+    if (off_ground_rows == 0) {
+        metrics.values["missed_m"] = missed_m;
+    } else {
+        const std::string ground =
+            ground_rows == 0 ? std::string("the trace holds no ground")
+                             : "the recorded ground spans " + fixed_text(profile.row_centre_m(0) - 0.5 * profile.row_m, 2) +
+                                   " to " + fixed_text(profile.row_centre_m(ground_rows - 1) + 0.5 * profile.row_m, 2) + " m";
+        metrics.not_measured["missed_m"] = std::to_string(off_ground_rows) + " rows of the strip that must be sprayed (" +
+                                           fixed_text(judging.strip_from_m, 2) + " to " +
+                                           fixed_text(judging.strip_to_m, 2) + " m along) lie off the ground: " + ground;
+    }
     metrics.values["strip_length_m"] = judging.strip_to_m - judging.strip_from_m;
 
     // Areas for the CV: the repeated one where both passes sprayed; if there is

@@ -35,11 +35,14 @@ struct VehicleSample {
 // there is one, else linear between the neighbours (the plant moves with bounded
 // acceleration: 0.16 mm error at most at 0.5 m/s^2 over 50 ms), never across a
 // headland turn (a change of pass_index): then the sample on t's side of it.
+// Before the first sample or after the last: nullopt (truth does not say).
 class VehicleTrack {
 public:
     explicit VehicleTrack(std::vector<VehicleSample> samples);  // any order; sorted here
     bool empty() const { return samples_.empty(); }
     std::optional<double> nozzle_line_along_m(TimeNs t) const;
+    // "the vehicle truth recorded spans 0.000 s to 41.250 s": why a time outside it has no position.
+    std::string describe_span() const;
     // The first pass_index's first sample time (e.g. when pass 1 began); nullopt if never.
     std::optional<TimeNs> pass_start_ns(int pass_index) const;
 
@@ -225,6 +228,9 @@ MetricSet spray_timing_metrics(const std::vector<SectionCommand>& commands,
 struct DoseProfile {
     double first_row_centre_m = 0.0;
     double row_m = 0.05;
+    // Rows of the recorded ground (the plant's grid), sprayed or not: a pass
+    // that never sprayed leaves no layer, but its ground was there.
+    std::size_t ground_rows = 0;
     std::vector<double> first_pass;
     std::vector<double> continuation;
     double row_centre_m(std::size_t row) const { return first_row_centre_m + static_cast<double>(row) * row_m; }
@@ -255,7 +261,9 @@ struct DepositionResult {
 // overlap_m: along-track length sprayed by both passes; missed_m: length of the
 // strip that must be sprayed (judging.strip_*) sprayed by neither: nothing
 // sprayed after the breakpoint makes the rest of the strip missed, nothing
-// sprayed at all the whole strip. cv_*_pct: Eq. 10-12 over the operational area
+// sprayed at all the whole strip; a strip reaching off the recorded ground
+// (more rows than ground_rows and the layers hold) leaves missed_m not
+// measured, never the unknown rows counted as missed. cv_*_pct: Eq. 10-12 over the operational area
 // (first pass only, up to cv_window_m before the repeated one), the repeated
 // area, and the continuation area (second pass only, cv_window_m after it), the
 // outer two cut at the first and last sprayed row; repeated_from_m /

@@ -1,5 +1,6 @@
 #include "harness/systems/breakpoint/breakpoint_system.h"
 
+#include <functional>
 #include <optional>
 
 #include "emulators/boom_height_sensor.h"
@@ -99,6 +100,54 @@ private:
     std::vector<Node*> all_;
 };
 
+// One field of each sample of `topic` as a key signal; samples without it
+// (a number) are left out, and so is a signal without any.
+void add_signal(std::vector<KeySignal>& signals, const RecordedTrace& trace, const char* topic, KeySignal signal,
+                const std::function<std::optional<double>(const nlohmann::json&)>& value_of) {
+    for (const RecordedSample& sample : trace.samples(topic)) {
+        if (const std::optional<double> value = value_of(sample.json)) {
+            signal.points.push_back({ns_to_seconds(sample.t_ns), *value});
+        }
+    }
+    if (!signal.points.empty()) signals.push_back(std::move(signal));
+}
+
+std::function<std::optional<double>(const nlohmann::json&)> field(const char* key) {
+    return [key](const nlohmann::json& sample) -> std::optional<double> {
+        const auto it = sample.find(key);
+        if (it == sample.end() || !it->is_number()) return std::nullopt;
+        return it->get<double>();
+    };
+}
+
+// Flow, valve, sections and where the nozzle line is against the breakpoint:
+// what the paper's Fig. 14 and Table 2 are made of.
+std::vector<KeySignal> breakpoint_key_signals(const RecordedTrace& trace) {
+    std::vector<KeySignal> signals;
+    add_signal(signals, trace, topics::kHydraulicsTruth, {"main-pipeline flow (truth)", "L/min", false, {}},
+               field("main_flow_l_min"));
+    add_signal(signals, trace, topics::kHydraulicsTruth, {"valve opening (truth)", "%", false, {}},
+               field("valve_opening_pct"));
+    add_signal(signals, trace, topics::kSectionValves,
+               {"sections commanded open (bit i: section i)", "mask", true, {}}, field("open_mask"));
+    add_signal(signals, trace, topics::kHydraulicsTruth, {"sections spraying (bit i: section i)", "mask", true, {}},
+               field("sections_spraying_mask"));
+    // The breakpoint is the case's, in the judging plan; a plan without one has nothing to measure against.
+    const nlohmann::json plan = nlohmann::json::parse(trace.meta_or("judging"), nullptr, /*allow_exceptions=*/false);
+    if (plan.is_object() && plan.contains("breakpoint_along_m") && plan["breakpoint_along_m"].is_number()) {
+        const double breakpoint_along_m = plan["breakpoint_along_m"].get<double>();
+        const auto nozzle_line_along_m = field("nozzle_line_along_m");
+        add_signal(signals, trace, topics::kVehicleTruth,
+                   {"nozzle line to the breakpoint, negative before it", "m", false, {}},
+                   [&](const nlohmann::json& sample) -> std::optional<double> {
+                       const std::optional<double> along_m = nozzle_line_along_m(sample);
+                       if (!along_m) return std::nullopt;
+                       return *along_m - breakpoint_along_m;
+                   });
+    }
+    return signals;
+}
+
 class BreakpointRun final : public SystemRun {
 public:
     BreakpointRun(const CaseSpec& spec, std::uint64_t seed)
@@ -188,6 +237,10 @@ public:
 
     SystemJudgement judge(const RecordedTrace& trace, const nlohmann::json& plan) const override {
         return judge_breakpoint_trace(trace, breakpoint_judging_plan_from_json(plan));
+    }
+
+    std::vector<KeySignal> key_signals(const RecordedTrace& trace) const override {
+        return breakpoint_key_signals(trace);
     }
 };
 
