@@ -1,5 +1,7 @@
 #include "harness/regression/history_report.h"
 
+#include "harness/report/sweep.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -30,10 +32,10 @@ std::vector<double> measured_values(const HistoryPoint& point) {
     return values;
 }
 
+// The sweep's percentile (harness/report/sweep.h), at 50: one definition of a median for every page.
 std::optional<double> median_of_sorted(const std::vector<double>& sorted) {
     if (sorted.empty()) return std::nullopt;
-    const std::size_t half = sorted.size() / 2;
-    return sorted.size() % 2 == 1 ? sorted[half] : (sorted[half - 1] + sorted[half]) / 2.0;
+    return percentile_of_sorted(sorted, 50.0);
 }
 
 std::string method_text(const ChangePointOptions& options) {
