@@ -158,7 +158,8 @@ TEST(CompareSamples, AShiftOfTheWorseWayIsFoundAtThirtySeedsAndOnlyThere) {
     // The same shift, but a minimum effect above it: significant and not news.
     CompareSettings coarse;
     coarse.min_effects["flow_error_pct"] = 0.5;
-    const MetricComparison& small = metric_of(compare_runs(base, head, coarse), "flow_error_pct");
+    const Comparison coarse_comparison = compare_runs(base, head, coarse);
+    const MetricComparison& small = metric_of(coarse_comparison, "flow_error_pct");
     EXPECT_EQ(small.verdict, CompareVerdict::unchanged);
     EXPECT_NE(small.reason.find("less than its minimum effect"), std::string::npos) << small.reason;
     // An improvement is the mirror image.
@@ -169,7 +170,8 @@ TEST(CompareSamples, RunsThatLoseTheMetricAreARegression) {
     std::mt19937_64 random(9);
     const auto base = output_of({drawn(random, 0.0, 1, 30)});
     const auto head = output_of({drawn(random, 0.0, 1, 30, /*lose_adjust=*/12)});
-    const MetricComparison& adjust = metric_of(compare_runs(base, head, {}), "flow_adjust_time_s");
+    const Comparison comparison = compare_runs(base, head, {});
+    const MetricComparison& adjust = metric_of(comparison, "flow_adjust_time_s");
     EXPECT_EQ(adjust.verdict, CompareVerdict::regressed) << adjust.reason;
     EXPECT_NE(adjust.reason.find("not measured in 0 -> 12 runs"), std::string::npos) << adjust.reason;
 }
