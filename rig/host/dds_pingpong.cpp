@@ -18,6 +18,12 @@ namespace {
 
 constexpr auto kMatchTimeout = std::chrono::milliseconds(15'000);
 constexpr auto kAnswerTimeout = std::chrono::milliseconds(5'000);
+// The second process's wait for its last answers to be acknowledged before it
+// exits (reliable delivery can take a heartbeat period or two on a loaded
+// machine), and the first process's patience with that exit: longer than the
+// wait, so that a slow acknowledgement is never a killed second process.
+constexpr auto kPongDeliveryWait = std::chrono::milliseconds(5'000);
+constexpr auto kPongExitGrace = 3 * kPongDeliveryWait;
 // The first ping is sent again at this period until answered: matched from the
 // writer's side is not yet matched from the reader's (as the lockstep hello is
 // repeated, docs/controller-contract.md section 7), and a slow second process
@@ -92,7 +98,7 @@ PingPongResult run_dds_pingpong(const PingPongOptions& options) {
         }
         if (seq > options.warmup_rounds) round_trips_us.push_back(round_trip.elapsed_s() * 1e6);
     }
-    const std::string ended = echo.stop(std::chrono::milliseconds(5000));
+    const std::string ended = echo.stop(kPongExitGrace);
     if (ended != "process exited with status 0") throw std::runtime_error("DDS ping-pong: the second process " + ended);
     result.rounds = options.rounds;
     result.mean_us = std::accumulate(round_trips_us.begin(), round_trips_us.end(), 0.0) /
@@ -122,7 +128,7 @@ int run_dds_pong(std::uint32_t domain_id, std::uint32_t rounds) {
             last_seq = std::max<std::uint64_t>(last_seq, tick.seq());
         }
     }
-    const auto undelivered = dds.wait_all_delivered(std::chrono::milliseconds(5'000));
+    const auto undelivered = dds.wait_all_delivered(kPongDeliveryWait);
     return undelivered.empty() ? 0 : 1;
 }
 
