@@ -43,16 +43,13 @@ TEST(ExcessGreen, ValuesOfAFrameRowByRow) {
     EXPECT_EQ(excess_green_values(frame), (std::vector<std::uint8_t>{152, 255, 90, 0}));
 }
 
-TEST(Otsu, SplitsTwoSpikesBetweenThem) {
+TEST(Otsu, SplitsTwoSpikesMidwayInTheGap) {
     // 700 values at 10, 300 at 200: every T in 11..200 separates them with the
-    // same between-class variance. OpenCV keeps the first T of such a run: the
-    // split just above the lower spike.
+    // same between-class variance; the middle of that run is (11 + 200) / 2 = 105.
     std::array<std::uint64_t, 256> histogram{};
     histogram[10] = 700;
     histogram[200] = 300;
-    const auto threshold = otsu_threshold(values_of(histogram));
-    ASSERT_TRUE(threshold.has_value());
-    EXPECT_EQ(*threshold, 11);
+    EXPECT_EQ(otsu_threshold(values_of(histogram)), 105);
 }
 
 TEST(Otsu, SplitsTwoBroadModesInTheirValley) {
@@ -68,6 +65,7 @@ TEST(Otsu, SplitsTwoBroadModesInTheirValley) {
     ASSERT_TRUE(threshold.has_value());
     EXPECT_GT(*threshold, 70);
     EXPECT_LE(*threshold, 150);
+    EXPECT_EQ(*threshold, (71 + 150) / 2);
 }
 
 TEST(Otsu, MatchesBruteForceOnAnUnevenHistogram) {
@@ -111,7 +109,7 @@ TEST(Otsu, NoSplitWithoutTwoValues) {
     EXPECT_FALSE(otsu_threshold(bare_soil).has_value());
     std::vector<std::uint8_t> one_leaf = bare_soil;
     one_leaf.back() = 150;
-    EXPECT_EQ(otsu_threshold(one_leaf), 1);  // the lone leaf value is the upper class
+    EXPECT_EQ(otsu_threshold(one_leaf), (1 + 150) / 2);  // the lone leaf value is the upper class, the gap 1..150
 }
 
 TEST(FitHomography, MapsTheFourCornersOfARoiAndKeepsIncidence) {

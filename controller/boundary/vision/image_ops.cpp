@@ -1,6 +1,7 @@
 #include "controller/boundary/vision/image_ops.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -55,15 +56,30 @@ std::vector<std::uint8_t> excess_green_values(const rig::camera::RgbImage& frame
 
 std::optional<int> otsu_threshold(std::span<const std::uint8_t> values) {
     use_fixed_opencv_threads();
-    if (values.empty()) return std::nullopt;
-    const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
-    if (*lowest == *highest) return std::nullopt;
+    std::array<bool, 256> present{};
+    for (const std::uint8_t value : values) present[value] = true;
+    const auto levels = std::count(present.begin(), present.end(), true);
+    if (levels < 2) return std::nullopt;
     // One row of 8-bit values; cv::threshold reads it, never writes it.
     const cv::Mat row(1, static_cast<int>(values.size()), CV_8UC1, const_cast<std::uint8_t*>(values.data()));
     cv::Mat classes;
-    // OpenCV returns the t of its split {value <= t} / {value > t}: Eq. 16's T is t + 1.
-    const double last_of_lower_class = cv::threshold(row, classes, 0.0, 255.0, cv::THRESH_BINARY | cv::THRESH_OTSU);
-    return static_cast<int>(last_of_lower_class) + 1;
+    // OpenCV's split is {value <= t} / {value > t}.
+    const int t = static_cast<int>(cv::threshold(row, classes, 0.0, 255.0, cv::THRESH_BINARY | cv::THRESH_OTSU));
+    if (t < 0 || t > 254) return std::nullopt;  // no split with both classes filled
+    // Every T from just above the lower class's top value to the upper
+    // class's bottom value splits these values alike (Otsu's criterion is
+    // flat across the empty gap between them). The ROI's bilinear samples
+    // fall in such gaps (a frame at one sample a pixel has few values
+    // between soil and leaf), so where T lies in the gap decides them: its
+    // middle, as far from both classes as the gap allows, not OpenCV's
+    // first T (which moved the density of seed-001's vision cases by up to
+    // 1.5 points).
+    int lower_top = t;
+    while (lower_top > 0 && !present[static_cast<std::size_t>(lower_top)]) --lower_top;
+    int upper_bottom = t + 1;
+    while (upper_bottom < 255 && !present[static_cast<std::size_t>(upper_bottom)]) ++upper_bottom;
+    if (!present[static_cast<std::size_t>(lower_top)] || !present[static_cast<std::size_t>(upper_bottom)]) return std::nullopt;
+    return (lower_top + 1 + upper_bottom) / 2;
 }
 
 Eigen::Matrix3d fit_homography(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to) {

@@ -39,10 +39,10 @@ std::vector<std::uint8_t> excess_green_values(const rig::camera::RgbImage& frame
 
 // Eq. 16: Otsu's threshold over 8-bit values, the T in 1..255 that maximises
 // the between-class variance w0 w1 (m0 - m1)^2 of {value < T} and
-// {value >= T}. Where several T share the maximum (a gap between two modes)
-// OpenCV keeps the first, the split just above the lower mode. Values with
-// fewer than two distinct levels (none, or bare soil all clipped to 0) have
-// no split: nullopt.
+// {value >= T} (OpenCV's). Where the split falls in an empty gap between two
+// modes, every T in the gap shares the maximum: the middle of the gap.
+// Values with fewer than two distinct levels (none, or bare soil all clipped
+// to 0) have no split: nullopt.
 std::optional<int> otsu_threshold(std::span<const std::uint8_t> values);
 
 // The H with to ~ H from over n >= 4 point pairs (exact for 4). Throws
