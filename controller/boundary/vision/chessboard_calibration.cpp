@@ -1,11 +1,14 @@
 #include "controller/boundary/vision/chessboard_calibration.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "controller/boundary/vision/image_ops.h"
 
@@ -13,17 +16,10 @@ namespace rig::controller::boundary::vision {
 
 namespace {
 
-// The ChESS ring: 16 samples at radius 5 px, every 22.5 deg.
-constexpr int kRingRadius = 5;
-constexpr std::array<std::array<int, 2>, 16> kRing{{{5, 0}, {5, 2}, {4, 4}, {2, 5}, {0, 5}, {-2, 5}, {-4, 4}, {-5, 2},
-                                                    {-5, 0}, {-5, -2}, {-4, -4}, {-2, -5}, {0, -5}, {2, -5}, {4, -4}, {5, -2}}};
-// A corner must be the largest response within this many px either way.
-constexpr int kSuppressRadius = 4;
-// ... and at least this share of the frame's strongest, and this strong
-// outright: a corner between squares 20 DN apart gives about 4 x 2 x 20 = 160,
-// a board's (~200 DN apart) about 1600, sensor noise (~3.5 DN grey) tens.
-constexpr double kResponseShare = 0.3;
-constexpr float kMinResponse = 160.0F;
+// cornerSubPix's search window: 5 px either way, within half the smallest
+// square the placements give (40 mm at ~1.1 m, ~30 px) so no neighbouring
+// corner falls inside it.
+constexpr int kSubPixelHalfWindowPx = 5;
 // The corners must lie on the fitted plane grid to this RMS.
 constexpr double kMaxRmsPx = 1.0;
 
@@ -46,52 +42,20 @@ Eigen::VectorXd null_vector(const Eigen::MatrixXd& a, const char* degenerate) {
 }
 
 // The points' centroid and their mean distance from it (Hartley's normalisation).
-template <int N>
-std::pair<Eigen::Matrix<double, N, 1>, double> centroid_and_spread(const std::vector<Eigen::Matrix<double, N, 1>>& points) {
-    Eigen::Matrix<double, N, 1> centroid = Eigen::Matrix<double, N, 1>::Zero();
-    for (const auto& p : points) centroid += p;
+std::pair<Eigen::Vector3d, double> centroid_and_spread(const std::vector<Eigen::Vector3d>& points) {
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : points) centroid += p;
     centroid /= static_cast<double>(points.size());
     double mean_distance = 0.0;
-    for (const auto& p : points) mean_distance += (p - centroid).norm();
+    for (const Eigen::Vector3d& p : points) mean_distance += (p - centroid).norm();
     return {centroid, mean_distance / static_cast<double>(points.size())};
-}
-
-// Hartley's normalisation: centroid to the origin, mean distance sqrt(2).
-Eigen::Matrix3d normalising(const std::vector<Eigen::Vector2d>& points) {
-    const auto [centroid, mean_distance] = centroid_and_spread(points);
-    const double scale = mean_distance > 0.0 ? std::sqrt(2.0) / mean_distance : 1.0;
-    Eigen::Matrix3d t;
-    t << scale, 0.0, -scale * centroid.x(), 0.0, scale, -scale * centroid.y(), 0.0, 0.0, 1.0;
-    return t;
 }
 
 }  // namespace
 
-Eigen::Matrix3d fit_homography(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to) {
-    if (from.size() != to.size() || from.size() < 4) {
-        throw std::invalid_argument("fit_homography: needs 4 or more point pairs, got " + std::to_string(from.size()) + " and " +
-                                    std::to_string(to.size()));
-    }
-    const Eigen::Matrix3d t_from = normalising(from);
-    const Eigen::Matrix3d t_to = normalising(to);
-    Eigen::MatrixXd a(2 * from.size(), 9);
-    for (std::size_t i = 0; i < from.size(); ++i) {
-        const Eigen::Vector2d p = apply(t_from, from[i]);
-        const Eigen::Vector2d q = apply(t_to, to[i]);
-        const auto r = static_cast<Eigen::Index>(2 * i);
-        a.row(r) << p.x(), p.y(), 1.0, 0.0, 0.0, 0.0, -q.x() * p.x(), -q.x() * p.y(), -q.x();
-        a.row(r + 1) << 0.0, 0.0, 0.0, p.x(), p.y(), 1.0, -q.y() * p.x(), -q.y() * p.y(), -q.y();
-    }
-    const Eigen::VectorXd h = null_vector(a, "fit_homography: degenerate points (collinear or repeated)");
-    Eigen::Matrix3d normalised;
-    normalised << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
-    Eigen::Matrix3d result = t_to.inverse() * normalised * t_from;
-    if (std::abs(result(2, 2)) > 1e-12) result /= result(2, 2);
-    return result;
-}
-
 ChessboardView find_chessboard(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                const ChessboardPlacement& placement) {
+    use_fixed_opencv_threads();
     ChessboardView view;
     if (const auto problem = rig::camera::frame_size_problem(frame, model.model().intrinsics)) {
         view.problem = *problem;
@@ -101,169 +65,71 @@ ChessboardView find_chessboard(const rig::camera::RgbImage& frame, const rig::ca
         view.problem = "chessboard placement: needs 2 x 2 or more inner corners and a square > 0";
         return view;
     }
-    const int width = frame.width;
-    const int height = frame.height;
-    std::vector<float> grey(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-    for (std::size_t i = 0; i < grey.size(); ++i) {
-        grey[i] = static_cast<float>(frame.bytes[3 * i] + frame.bytes[3 * i + 1] + frame.bytes[3 * i + 2]) / 3.0F;
-    }
-    auto at = [&](int u, int v) { return grey[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)]; };
-
-    // The ChESS response of every pixel far enough from the border.
-    std::vector<float> response(grey.size(), 0.0F);
-    float strongest = 0.0F;
-    for (int v = kRingRadius + 1; v < height - kRingRadius - 1; ++v) {
-        for (int u = kRingRadius + 1; u < width - kRingRadius - 1; ++u) {
-            std::array<float, 16> ring;
-            float ring_sum = 0.0F;
-            for (std::size_t n = 0; n < 16; ++n) {
-                ring[n] = at(u + kRing[n][0], v + kRing[n][1]);
-                ring_sum += ring[n];
-            }
-            float sum_response = 0.0F;
-            for (std::size_t n = 0; n < 4; ++n) sum_response += std::abs(ring[n] + ring[n + 8] - ring[n + 4] - ring[n + 12]);
-            float diff_response = 0.0F;
-            for (std::size_t n = 0; n < 8; ++n) diff_response += std::abs(ring[n] - ring[n + 8]);
-            float local = 0.0F;
-            for (int dv = -1; dv <= 1; ++dv) {
-                for (int du = -1; du <= 1; ++du) local += at(u + du, v + dv);
-            }
-            const float mean_response = std::abs(ring_sum / 16.0F - local / 9.0F);
-            const float r = sum_response - diff_response - 16.0F * mean_response;
-            response[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)] = r;
-            strongest = std::max(strongest, r);
-        }
-    }
-    if (strongest <= 0.0F) {
-        view.problem = "no chessboard corner in the frame";
+    const cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.bytes.data()));
+    cv::Mat grey;
+    cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    const cv::Size pattern(placement.inner_cols, placement.inner_rows);
+    const std::string declared = std::to_string(placement.inner_cols) + " x " + std::to_string(placement.inner_rows) + " inner corners (" +
+                                 std::to_string(placement.inner_cols * placement.inner_rows) + ")";
+    std::vector<cv::Point2f> found;
+    // NORMALIZE_IMAGE: the board lies in the field's light, not on a scanner.
+    // FAST_CHECK: a frame without a board is refused in milliseconds.
+    // Not ADAPTIVE_THRESH: on a frame of a board with fewer corners than
+    // declared it searched for 20 s of CPU (measured on this rig's rendered
+    // frames; 5 ms without it), a hang for a calibration step; the rig's
+    // lighting is even over a frame, where a global threshold suffices.
+    if (!cv::findChessboardCorners(grey, pattern, found, cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK)) {
+        view.problem = "no chessboard of " + declared + " in the frame (none in view, partly hidden, or another size)";
         return view;
     }
-    auto response_at = [&](int u, int v) {
-        return response[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)];
-    };
+    // The saddle point to sub-pixel precision: every grey-level gradient near
+    // a corner is perpendicular to the line from the corner (Foerstner).
+    cv::cornerSubPix(grey, found, cv::Size(kSubPixelHalfWindowPx, kSubPixelHalfWindowPx), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 0.001));
 
-    // A saddle point to sub-pixel precision (Foerstner's corner operator): at
-    // the true corner p every grey-level gradient g(q) in the window is
-    // perpendicular to q - p, so p solves sum(g g^T) p = sum(g g^T q).
-    auto refine_saddle = [&](Eigen::Vector2d p) {
-        constexpr int kHalf = 4;
-        for (int step = 0; step < 5; ++step) {
-            const int cu = static_cast<int>(std::floor(p.x()));
-            const int cv = static_cast<int>(std::floor(p.y()));
-            Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
-            Eigen::Vector2d right = Eigen::Vector2d::Zero();
-            for (int dv = -kHalf; dv <= kHalf; ++dv) {
-                for (int du = -kHalf; du <= kHalf; ++du) {
-                    const int qu = cu + du;
-                    const int qv = cv + dv;
-                    if (qu < 1 || qv < 1 || qu >= width - 1 || qv >= height - 1) continue;
-                    const Eigen::Vector2d g(0.5 * (at(qu + 1, qv) - at(qu - 1, qv)), 0.5 * (at(qu, qv + 1) - at(qu, qv - 1)));
-                    const Eigen::Matrix2d gg = g * g.transpose();
-                    normal += gg;
-                    right += gg * Eigen::Vector2d(qu + 0.5, qv + 0.5);
-                }
-            }
-            if (std::abs(normal.determinant()) < 1e-6) break;
-            const Eigen::Vector2d next = normal.inverse() * right;
-            if ((next - p).norm() > 3.0) break;  // left the corner: keep the last estimate
-            const bool settled = (next - p).norm() < 0.01;
-            p = next;
-            if (settled) break;
-        }
-        return p;
-    };
-
-    // Local maxima above a share of the strongest, refined to the saddle.
-    struct Candidate {
-        Eigen::Vector2d undistorted;
-        float strength;
-    };
-    std::vector<Candidate> candidates;
-    const float floor = std::max(kMinResponse, static_cast<float>(kResponseShare) * strongest);
-    const int margin = kRingRadius + 1 + kSuppressRadius;
-    for (int v = margin; v < height - margin; ++v) {
-        for (int u = margin; u < width - margin; ++u) {
-            const float r = response_at(u, v);
-            if (r < floor) continue;
-            bool is_max = true;
-            for (int dv = -kSuppressRadius; dv <= kSuppressRadius && is_max; ++dv) {
-                for (int du = -kSuppressRadius; du <= kSuppressRadius; ++du) {
-                    if (du == 0 && dv == 0) continue;
-                    const float other = response_at(u + du, v + dv);
-                    // Ties go to the first in raster order.
-                    if (other > r || (other == r && (dv < 0 || (dv == 0 && du < 0)))) {
-                        is_max = false;
-                        break;
-                    }
-                }
-            }
-            if (!is_max) continue;
-            const Eigen::Vector2d refined = refine_saddle(Eigen::Vector2d(u + 0.5, v + 0.5));
-            const auto normalized = rig::camera::undistort_normalized(model.model().distortion, model.pixel_to_distorted_normalized(refined));
-            if (!normalized) continue;
-            candidates.push_back({model.undistorted_pixel(*normalized), r});
-        }
-    }
-    const std::size_t expected = static_cast<std::size_t>(placement.inner_cols) * static_cast<std::size_t>(placement.inner_rows);
-    if (candidates.size() < expected) {
-        view.problem = "found " + std::to_string(candidates.size()) + " chessboard corners, expected " + std::to_string(expected);
+    // OpenCV's order: rows of inner_cols corners, starting at any of the
+    // board's ends. Ours (the placement's): i across (boom x, right in the
+    // image), j ahead (boom y, up in the image), index j * inner_cols + i.
+    // A square pattern's rows may also run ahead: then they are our columns.
+    const int cols = placement.inner_cols;
+    const int rows = placement.inner_rows;
+    auto at = [&](int col, int row) { return found[static_cast<std::size_t>(row * cols + col)]; };
+    const cv::Point2f along_row = at(cols - 1, 0) - at(0, 0);
+    const cv::Point2f along_column = at(0, rows - 1) - at(0, 0);
+    const bool rows_run_across = std::abs(along_row.x) >= std::abs(along_row.y);
+    if (!rows_run_across && cols != rows) {
+        view.problem = "the chessboard's " + std::to_string(cols) + "-corner rows run ahead, not across: it lies turned from its declared placement";
         return view;
     }
-
-    // The grid's four extreme corners: (0, 0) nearest-left (smallest u - v),
-    // (cols-1, 0) nearest-right (largest u + v), (cols-1, rows-1) farthest-
-    // right (largest u - v), (0, rows-1) farthest-left (smallest u + v).
-    auto extreme = [&](auto key) {
-        return std::max_element(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) { return key(a) < key(b); })
-            ->undistorted;
-    };
-    const double cols = placement.inner_cols - 1;
-    const double rows = placement.inner_rows - 1;
-    const std::array<Eigen::Vector2d, 4> grid_corners{Eigen::Vector2d(0, 0), Eigen::Vector2d(cols, 0), Eigen::Vector2d(cols, rows),
-                                                      Eigen::Vector2d(0, rows)};
-    const std::array<Eigen::Vector2d, 4> image_corners{
-        extreme([](const Candidate& c) { return c.undistorted.y() - c.undistorted.x(); }),
-        extreme([](const Candidate& c) { return c.undistorted.x() + c.undistorted.y(); }),
-        extreme([](const Candidate& c) { return c.undistorted.x() - c.undistorted.y(); }),
-        extreme([](const Candidate& c) { return -c.undistorted.x() - c.undistorted.y(); })};
-    Eigen::Matrix3d grid_to_pixel;
-    try {
-        grid_to_pixel = perspective_transform(grid_corners, image_corners);
-    } catch (const std::invalid_argument&) {
-        view.problem = "the chessboard corners found do not span a grid";
-        return view;
+    std::vector<Eigen::Vector2d> distorted(found.size());
+    for (int row = 0; row < rows; ++row) {
+        for (int col = 0; col < cols; ++col) {
+            int i = rows_run_across ? col : row;
+            int j = rows_run_across ? row : col;
+            const bool i_reversed = rows_run_across ? along_row.x < 0.0F : along_column.x < 0.0F;
+            const bool j_reversed = rows_run_across ? along_column.y > 0.0F : along_row.y > 0.0F;
+            if (i_reversed) i = cols - 1 - i;
+            if (j_reversed) j = rows - 1 - j;
+            // OpenCV's pixel centres lie on integers, rig::camera's at +0.5.
+            distorted[static_cast<std::size_t>(j * cols + i)] = Eigen::Vector2d(at(col, row).x + 0.5, at(col, row).y + 0.5);
+        }
     }
-    // Every grid corner matched to the nearest candidate within a third of a square.
+    view.corners_px = undistort_pixels(distorted, model.model().intrinsics, model.model().distortion);
+
     std::vector<Eigen::Vector2d> plane_points;
-    std::vector<Eigen::Vector2d> image_points;
-    std::vector<bool> used(candidates.size(), false);
-    for (int j = 0; j < placement.inner_rows; ++j) {
-        for (int i = 0; i < placement.inner_cols; ++i) {
-            const Eigen::Vector2d predicted = apply(grid_to_pixel, Eigen::Vector2d(i, j));
-            const double square_px = (apply(grid_to_pixel, Eigen::Vector2d(i + 1, j)) - predicted).norm();
-            std::size_t best = candidates.size();
-            double best_distance = square_px / 3.0;
-            for (std::size_t c = 0; c < candidates.size(); ++c) {
-                const double d = (candidates[c].undistorted - predicted).norm();
-                if (!used[c] && d < best_distance) {
-                    best = c;
-                    best_distance = d;
-                }
-            }
-            if (best == candidates.size()) {
-                view.problem = "chessboard corner (" + std::to_string(i) + ", " + std::to_string(j) + ") not found near (" +
-                               std::to_string(predicted.x()) + ", " + std::to_string(predicted.y()) + ") px";
-                return view;
-            }
-            used[best] = true;
-            view.corners_px.push_back(candidates[best].undistorted);
+    for (int j = 0; j < rows; ++j) {
+        for (int i = 0; i < cols; ++i) {
             plane_points.emplace_back(placement.origin_right_m + i * placement.square_m, placement.origin_ahead_m + j * placement.square_m);
-            image_points.push_back(candidates[best].undistorted);
         }
     }
-    view.plane_to_pixel = fit_homography(plane_points, image_points);
+    try {
+        view.plane_to_pixel = fit_homography(plane_points, view.corners_px);
+    } catch (const std::invalid_argument& error) {
+        view.problem = std::string("the chessboard corners found fix no homography: ") + error.what();
+        return view;
+    }
     double squared = 0.0;
-    for (std::size_t n = 0; n < plane_points.size(); ++n) squared += (apply(view.plane_to_pixel, plane_points[n]) - image_points[n]).squaredNorm();
+    for (std::size_t n = 0; n < plane_points.size(); ++n) squared += (apply(view.plane_to_pixel, plane_points[n]) - view.corners_px[n]).squaredNorm();
     view.rms_px = std::sqrt(squared / static_cast<double>(plane_points.size()));
     if (view.rms_px > kMaxRmsPx) {
         view.problem = "the corners found are not a chessboard's grid (RMS " + std::to_string(view.rms_px) + " px from the fitted homography)";

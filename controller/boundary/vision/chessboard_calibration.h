@@ -2,18 +2,12 @@
 // Sec. 2.2.2's chessboards: the camera's pose on the boom from one image of a
 // chessboard lying in a known place, in the boom plane (Eq. 5's homography)
 // or on the ground under it (Eq. 6's second board, with the laser's h). The
-// paper estimates both with a calibration library it does not name; here:
-//   corners   the ChESS response (Bennett and Lasenby, "ChESS - Quick and
-//             robust detection of chess-board features", CVIU 2014): on a ring
-//             of 16 samples, the "sum" response of opposite quadrants less the
-//             "diff" response of opposite samples less the ring's offset from
-//             the local mean; local maxima, refined to the grey-level saddle
-//             (Foerstner: every gradient around a corner is perpendicular to
-//             the line from the corner)
-//   grid      the four extreme corners (min / max of u + v and u - v) give a
-//             first homography, every corner is matched to its predicted place
-//   H         the direct linear transform over all corners, normalised
-//             (Hartley), solved by SVD
+// paper estimates both with a calibration library it does not name; here
+// OpenCV (image_ops.h):
+//   corners   cv::findChessboardCorners (the grid and its order), refined to
+//             the grey-level saddle by cv::cornerSubPix, then undistorted
+//             (cv::undistortPoints) with the camera's calibration
+//   H         cv::findHomography over all corners (least squares, refined)
 //   pose      K^-1 H = [r1 r2 t] up to scale; r3 = r1 x r2, made a rotation
 //             by SVD; the camera's position and pitch / roll / yaw on the boom;
 //             or, from both boards at once (the paper's two planes), the DLT
@@ -27,6 +21,7 @@
 
 #include <Eigen/Dense>
 
+#include "controller/boundary/vision/image_ops.h"  // fit_homography
 #include "rig/camera/pinhole_camera.h"
 #include "rig/camera/rgb_image.h"
 
@@ -56,13 +51,11 @@ struct ChessboardView {
 // the board's plane to the undistorted image. `model` supplies the intrinsics
 // and distortion (its mounting is not used). Never throws for what the frame
 // holds: no board, a partly hidden one or a corner count that does not match
-// gives ok = false and says why.
+// gives ok = false and says why. The board lies as declared: its rows of
+// inner_cols corners run across the image (roll and yaw within
+// CameraMounting's 45 deg); a square pattern may be seen either way round.
 ChessboardView find_chessboard(const rig::camera::RgbImage& frame, const rig::camera::PinholeCamera& model,
                                const ChessboardPlacement& placement);
-
-// Normalised DLT over n >= 4 point pairs: the H with to ~ H from. Throws
-// std::invalid_argument for fewer than 4 pairs, unequal counts or a degenerate set.
-Eigen::Matrix3d fit_homography(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to);
 
 // The camera's mounting on the boom from the homography of the horizontal
 // plane z = plane_z_m (boom frame) to undistorted pixels. Throws

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "controller/boundary/vision/image_ops.h"
 
@@ -45,7 +46,7 @@ constexpr int kEdgePx = 2;
 // Boards are 0.3 as wide as long; above this the pixels are not one board.
 constexpr double kMaxSpreadRatio = 0.5;
 
-int threshold_of(const Histogram& histogram, int floor) { return std::max(otsu_threshold(histogram).value_or(256), floor); }
+int threshold_of(std::span<const std::uint8_t> values, int floor) { return std::max(otsu_threshold(values).value_or(256), floor); }
 
 }  // namespace
 
@@ -56,40 +57,38 @@ NozzleCalibration find_nozzle_points(const rig::camera::RgbImage& frame, const r
         result.problem = *problem;
         return result;
     }
-    Histogram green{};
-    Histogram red{};
-    for (int v = 0; v < frame.height; ++v) {
-        for (int u = 0; u < frame.width; ++u) {
-            const rig::camera::Rgb p = frame.at(u, v);
-            ++green[green_index(p)];
-            ++red[red_index(p)];
-        }
+    const std::size_t pixel_count = frame.bytes.size() / 3U;
+    std::vector<std::uint8_t> green(pixel_count);
+    std::vector<std::uint8_t> red(pixel_count);
+    for (std::size_t i = 0; i < pixel_count; ++i) {
+        const rig::camera::Rgb p{frame.bytes[3 * i], frame.bytes[3 * i + 1], frame.bytes[3 * i + 2]};
+        green[i] = green_index(p);
+        red[i] = red_index(p);
     }
     result.green_threshold = threshold_of(green, colour_floor);
     result.red_threshold = threshold_of(red, colour_floor);
 
-    // The selected pixels' centres, undistorted with the camera's calibration.
+    // The selected pixels' centres, then undistorted with the camera's calibration.
     std::vector<Eigen::Vector2d> green_points;
     std::vector<Eigen::Vector2d> red_points;
     bool green_at_edge = false;
     bool red_at_edge = false;
     for (int v = 0; v < frame.height; ++v) {
         for (int u = 0; u < frame.width; ++u) {
-            const rig::camera::Rgb p = frame.at(u, v);
-            const bool is_green = green_index(p) >= result.green_threshold;
-            const bool is_red = red_index(p) >= result.red_threshold;
+            const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(frame.width) + static_cast<std::size_t>(u);
+            const bool is_green = green[i] >= result.green_threshold;
+            const bool is_red = red[i] >= result.red_threshold;
             if (!is_green && !is_red) continue;
             // A board cut by the frame's edge gives a line through its visible part only.
             const bool at_edge = u < kEdgePx || v < kEdgePx || u >= frame.width - kEdgePx || v >= frame.height - kEdgePx;
             green_at_edge = green_at_edge || (is_green && at_edge);
             red_at_edge = red_at_edge || (is_red && at_edge);
-            const auto normalized = rig::camera::undistort_normalized(model.model().distortion,
-                                                                      model.pixel_to_distorted_normalized(Eigen::Vector2d(u + 0.5, v + 0.5)));
-            if (!normalized) continue;
-            const Eigen::Vector2d undistorted = model.undistorted_pixel(*normalized);
-            (is_green ? green_points : red_points).push_back(undistorted);
+            (is_green ? green_points : red_points).emplace_back(u + 0.5, v + 0.5);
         }
     }
+    const rig::camera::CameraModel& calibration = model.model();
+    green_points = undistort_pixels(green_points, calibration.intrinsics, calibration.distortion);
+    red_points = undistort_pixels(red_points, calibration.intrinsics, calibration.distortion);
     if (green_points.size() < 50) {
         result.problem = "no boom board: " + std::to_string(green_points.size()) + " pixels at 2G - B - R >= " + std::to_string(result.green_threshold);
         return result;

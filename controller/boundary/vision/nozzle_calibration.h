@@ -10,7 +10,8 @@
 //       boom line: the nozzle points, e.g. (107.2, 662.3), (579.6, 661.1),
 //       (1044.4, 659.9) px in the paper
 // The paper undistorts the image first; here each selected pixel's centre is
-// undistorted instead (the same points, without resampling the frame). The
+// undistorted instead (cv::undistortPoints: the same points, without
+// resampling the frame). Otsu is OpenCV's (image_ops.h). The
 // lines are total least squares (the principal axis of the pixels), not
 // z = a i + b: a nozzle board's line is nearly vertical in the image (Eq. 3's
 // slope is -50), where fitting z on i is ill-conditioned.

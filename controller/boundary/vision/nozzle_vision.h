@@ -19,10 +19,11 @@
 //            (X' + w/2, Y' + h1) is meant; its rotation signs belong to the
 //            paper's axes, here x right, y forward.)
 //   warp     the ROI's image quadrilateral to a w x h2 rectangle (a
-//            perspective transform; lens distortion applied per sample, so
-//            undistortion and warp are one resampling)
+//            perspective transform with the lens undone in the same
+//            resampling: OpenCV's undistortion map and fixed-point remap,
+//            image_ops.h)
 //   Eq. 15   ExG = 2G - R - B, clipped 0..255
-//   Eq. 16   plant where ExG >= T, T = max(Otsu over the whole frame, floor)
+//   Eq. 16   plant where ExG >= T, T = max(Otsu over the whole frame (OpenCV), floor)
 //            (S7: Otsu alone splits bare soil's noise into "plants")
 //   Eq. 17   D = plant pixels / ROI pixels
 //   Eq. 14   the level of D at the current speed
