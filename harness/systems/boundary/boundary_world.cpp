@@ -209,14 +209,17 @@ void CameraNode::configure(DdsContext& dds) {
             // priority, or on a lockstep case's leased CPU (rig/host/cpu_lease.h).
             // Rendering runs beside the loop, on any CPU, below it: it must not
             // take the loop's core. In real time its frames have deadlines, so
-            // it outweighs the machine's other time-sharing work.
+            // it goes before the run's other time-sharing threads.
             const std::string refused =
                 drop_to_time_sharing(clock_ == ClockMode::realtime ? std::optional<int>(kRealtimeRenderNice) : std::nullopt);
             leave_leased_cpu();
             const std::lock_guard lock(render_scheduling_mutex_);
             render_scheduling_ = refused.empty() ? describe_thread_placement() : refused;
         },
-        [this] { dds_->notify_data_arrived(); });
+        [this] {
+            // Real time: a frame left for later is due as soon as it is rendered.
+            if (clock_ == ClockMode::realtime) dds_->notify_data_arrived();
+        });
     // Frame 0 is due at t = 0, before any wake of the loop could wait for it:
     // rendered before time starts (the first frame also builds the crop
     // truth's tiles in view).
