@@ -1265,6 +1265,18 @@ TEST(CaseSpec, RealtimeLatenessKeysParseWithDefaultsAndBounds) {
     EXPECT_EQ(set.realtime.late_after_ms, 5.0);
     EXPECT_EQ(set.realtime.max_late_pct, 0.5);
     EXPECT_EQ(set.realtime.max_lateness_ms, 40.0);
+    EXPECT_TRUE(set.realtime.devices.empty());
+    // A device's own limits: what it leaves out takes the case's.
+    const CaseSpec own = parse_case(realtime +
+                                        "realtime:\n  late_after_ms: 50\n  devices:\n"
+                                        "    camera_left: { late_after_ms: 85, max_lateness_ms: 85 }\n",
+                                    "case.yaml");
+    ASSERT_EQ(own.realtime.devices.count("camera_left"), 1u);
+    EXPECT_EQ(own.realtime.devices.at("camera_left").late_after_ms, 85.0);
+    EXPECT_EQ(own.realtime.devices.at("camera_left").max_lateness_ms, 85.0);
+    EXPECT_EQ(own.realtime.devices.at("camera_left").max_late_pct, 1.0);
+    EXPECT_EQ(own.realtime.limits_of("camera_left").late_after_ms, 85.0);
+    EXPECT_EQ(own.realtime.limits_of("boundary_plant").late_after_ms, 50.0);
     ASSERT_TRUE(set.rig_faults.has_value());
     EXPECT_EQ(set.rig_faults->master_stall_at_s, 3.0);
     EXPECT_EQ(set.rig_faults->master_stall_for_s, 0.5);
@@ -1281,6 +1293,12 @@ TEST(CaseSpec, RealtimeLatenessKeysParseWithDefaultsAndBounds) {
          "is below late_after_ms"},
         {realtime + "realtime: { late_after_ms: 500 }\n", "realtime.late_after_ms", "is below late_after_ms"},
         {realtime + "realtime: { max_jitter_ms: 5 }\n", "realtime.max_jitter_ms", ""},
+        {realtime + "realtime: { devices: { camera_left: { late_after_ms: 0 } } }\n",
+         "realtime.devices.camera_left.late_after_ms", "must be"},
+        // A device's maximum below the case's late_after_ms it inherits.
+        {realtime + "realtime: { late_after_ms: 50, devices: { camera_left: { max_lateness_ms: 20 } } }\n",
+         "realtime.devices.camera_left.max_lateness_ms", "is below late_after_ms"},
+        {realtime + "realtime: { devices: { camera_left: { late_ms: 5 } } }\n", "realtime.devices.camera_left.late_ms", ""},
         {realtime + "rig_faults: { master_stall_at_s: 3 }\n", "rig_faults.master_stall_for_s", ""},
         {realtime + "rig_faults: { master_stall_at_s: 3, master_stall_for_s: 0 }\n", "rig_faults.master_stall_for_s",
          "must be"},

@@ -471,6 +471,15 @@ std::string rig_lateness_summary(const nlohmann::json& lateness) {
                            significant_text(bound.at("late_after_ms").get<double>(), 6) + " ms late; bound: at most " +
                            significant_text(bound.at("max_lateness_ms").get<double>(), 6) + " ms, at most " +
                            significant_text(bound.at("max_late_pct").get<double>(), 6) + " % late";
+        // Devices judged by limits of their own (a record from before they existed has none).
+        if (const auto own = bound.find("devices"); own != bound.end() && own->is_object()) {
+            for (const auto& [device, limits] : own->items()) {
+                line += "; " + valid_utf8(device) + " by its own: at most " +
+                        significant_text(limits.at("max_lateness_ms").get<double>(), 6) + " ms, at most " +
+                        significant_text(limits.at("max_late_pct").get<double>(), 6) + " % more than " +
+                        significant_text(limits.at("late_after_ms").get<double>(), 6) + " ms late";
+            }
+        }
         if (const nlohmann::json& stall = lateness.at("injected_stall"); stall.is_object()) {
             line += "; self-test: the rig's loop was stalled " + significant_text(stall.at("for_s").get<double>(), 6) +
                     " s at t = " + significant_text(stall.at("at_s").get<double>(), 6) + " s (rig_faults)";

@@ -10,6 +10,8 @@
 //     late_after_ms: 10        # an emission this much past its deadline is late
 //     max_late_pct: 1          # more late emissions than this share: invalid
 //     max_lateness_ms: 100     # any one emission later than this: invalid
+//     devices:                 # a device judged by limits of its own (by node name);
+//       camera_left: { late_after_ms: 85, max_lateness_ms: 85 }   # keys left out: the above
 //   rig_faults:                # self-test only: never in a case that judges a controller
 //     master_stall_at_s: 3     # the rig's real-time loop stops stepping at this case time ...
 //     master_stall_for_s: 0.5  # ... for this long

@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -151,6 +152,9 @@ std::string describe_thread_placement() {
     int policy = SCHED_OTHER;
     sched_param param{};
     if (pthread_getschedparam(pthread_self(), &policy, &param) == 0) text += ", " + policy_name(policy);
+    errno = 0;
+    const int nice = getpriority(PRIO_PROCESS, static_cast<id_t>(gettid()));  // -1 is also a nice value: errno tells
+    if (errno == 0 && nice != 0) text += ", nice " + std::to_string(nice);
     return text;
 }
 

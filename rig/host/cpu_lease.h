@@ -54,7 +54,7 @@ private:
 void leave_leased_cpu();
 
 // The calling thread's CPUs and scheduling policy, e.g. "CPU 1 of 2, SCHED_BATCH"
-// or "CPUs 0-1 of 2, SCHED_OTHER" (a run's facts).
+// or "CPUs 0-1 of 2, SCHED_OTHER, nice -10" (its nice value when not 0) (a run's facts).
 std::string describe_thread_placement();
 
 }  // namespace rig

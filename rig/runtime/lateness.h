@@ -16,7 +16,7 @@ namespace rig {
 
 // A real-time case's `realtime:` section (docs/metrics.md "Verdicts"). Bounds
 // are checked by the case loader (harness/spec/realtime_spec.cpp).
-struct LatenessBound {
+struct LatenessLimits {
     // An emission counts as late when it leaves more than this after its
     // deadline; (0, 1000] ms. 10 ms: one period of the device grid (the wheel
     // encoder and the flow meter publish at 100 Hz), so a late emission is one a
@@ -39,19 +39,35 @@ struct LatenessBound {
     double max_lateness_ms = 100.0;
 };
 
+struct LatenessBound : LatenessLimits {
+    // Devices (by node name) whose emissions are judged by limits of their own,
+    // set from what a late emission of theirs costs a metric (a camera's frame
+    // is judged by the duty commanded a decision delay after its exposure, not
+    // by the 100 Hz grid): each is counted against its own limits, its share of
+    // late emissions among its own emissions, and stays out of the shared
+    // count of every other device.
+    std::map<std::string, LatenessLimits> devices;
+    // The limits `device` is judged by.
+    const LatenessLimits& limits_of(const std::string& device) const {
+        const auto own = devices.find(device);
+        return own == devices.end() ? *this : own->second;
+    }
+};
+
 // One device's share of the account.
 struct DeviceLateness {
     std::size_t emissions = 0;
-    std::size_t late = 0;            // later than the bound's late_after_ms
+    std::size_t late = 0;            // later than its limits' late_after_ms
     double max_ms = 0.0;             // its latest emission, against its deadline
     TimeNs max_deadline_ns = 0;      // the deadline of that emission (case time)
+    TimeNs first_late_deadline_ns = 0;  // the deadline of its first late emission (when late > 0)
 };
 
 // The account at the end of a run (or at any moment of it).
 struct LatenessVerdict {
     LatenessBound bound;
     std::size_t emissions = 0;       // timed emissions of every device
-    std::size_t late = 0;
+    std::size_t late = 0;            // each late by its own device's limits
     double late_pct = 0.0;           // late / emissions, in %
     double max_ms = 0.0;             // the latest emission of the run
     std::string worst_device;        // whose it was ("" without emissions)

@@ -4,6 +4,7 @@
 // loop): configure (create endpoints, validate parameters) -> activate -> step ...
 // -> shutdown. Nodes are shut down in the reverse order of configuration.
 #include <string>
+#include <vector>
 
 #include "rig/runtime/clock.h"
 
@@ -26,6 +27,20 @@ public:
     virtual TimeNs step(TimeNs now_ns) = 0;
     // True when a reader holds samples not yet taken (the node is due at once).
     virtual bool has_unread_input() const { return false; }
+    // How a real-time loop (rig/runtime/realtime.h) counts this node's lateness.
+    // false, most nodes: a step emits what is due, so each timed wake is one
+    // emission, late by when its step began. true: the node's emission waits on
+    // work of its own that runs on another thread (a camera's frame still
+    // rendering), and its step never waits for that work: a step that waited
+    // would hold up every node after it in the loop. Such a node emits when
+    // its work is done and reports each emission's deadline through
+    // take_emitted_deadlines(); its has_unread_input() turns true when the work
+    // is done, and the worker wakes the loop (DdsContext::notify_data_arrived).
+    virtual bool reports_own_emissions() const { return false; }
+    // With reports_own_emissions(): the deadlines (case time) of the emissions
+    // its steps made since the last call, oldest first. The loop counts each
+    // late by when the step that made it began, against this node alone.
+    virtual std::vector<TimeNs> take_emitted_deadlines() { return {}; }
     virtual void shutdown() {}
 };
 

@@ -4,11 +4,16 @@
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <mutex>
+#include <optional>
 #include <iostream>
 
 namespace rig {
@@ -63,11 +68,70 @@ std::string raise_thread_to_realtime(std::thread& thread, int priority) {
     return error == 0 ? std::string() : std::string("SCHED_FIFO refused: ") + std::strerror(error);
 }
 
-std::string drop_to_time_sharing() {
+std::string drop_to_time_sharing(std::optional<int> nice) {
     sched_param param{};
     param.sched_priority = 0;
-    const int error = pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
-    return error == 0 ? std::string() : std::string("SCHED_OTHER refused: ") + std::strerror(error);
+    if (const int error = pthread_setschedparam(pthread_self(), SCHED_OTHER, &param); error != 0) {
+        return std::string("SCHED_OTHER refused: ") + std::strerror(error);
+    }
+    // On Linux a nice value belongs to the thread (its id), not the process.
+    if (nice && setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), *nice) != 0) {
+        return "nice " + std::to_string(*nice) + " refused: " + std::strerror(errno);
+    }
+    return {};
+}
+
+namespace {
+
+// /proc/self/autogroup reads "/autogroup-140 nice 0"; writing a number sets the nice value.
+constexpr const char* kAutogroupFile = "/proc/self/autogroup";
+
+std::optional<int> autogroup_nice() {
+    std::ifstream in(kAutogroupFile);
+    std::string group;
+    std::string word;
+    int nice = 0;
+    if (in >> group >> word >> nice && word == "nice") return nice;
+    return std::nullopt;
+}
+
+bool set_autogroup_nice(int nice) {
+    std::ofstream out(kAutogroupFile);
+    out << nice;
+    out.flush();
+    return static_cast<bool>(out);
+}
+
+std::mutex session_weight_mutex;
+int session_weight_holders = 0;  // guards alive that raised it
+int session_nice_before = 0;
+
+}  // namespace
+
+SessionCpuWeight::SessionCpuWeight(int nice) {
+    const std::lock_guard lock(session_weight_mutex);
+    const std::optional<int> current = autogroup_nice();
+    if (!current) {
+        detail_ = std::string("no session autogroup (") + kAutogroupFile + " unreadable)";
+        return;
+    }
+    if (session_weight_holders == 0) {
+        if (!set_autogroup_nice(nice)) {
+            detail_ = "session autogroup nice " + std::to_string(nice) + " refused (" + std::strerror(errno) +
+                      "), left at " + std::to_string(*current);
+            return;
+        }
+        session_nice_before = *current;
+    }
+    ++session_weight_holders;
+    raised_ = true;
+    detail_ = "session autogroup nice " + std::to_string(nice) + " (was " + std::to_string(session_nice_before) + ")";
+}
+
+SessionCpuWeight::~SessionCpuWeight() {
+    if (!raised_) return;
+    const std::lock_guard lock(session_weight_mutex);
+    if (--session_weight_holders == 0) set_autogroup_nice(session_nice_before);
 }
 
 RealtimeMaster::RealtimeMaster(DdsContext& dds, LockstepTimeouts timeouts) : dds_(dds), remotes_(dds, timeouts) {}
@@ -104,21 +168,21 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
         if (now >= end_ns) return;
         for (TruthModel* model : truth_models_) model->advance_to(now);
         for (Local& local : locals_) {
-            if (local.next_wake_ns <= now) {
-                // Late by when its step began: a long step of a node before it in
-                // this pass delays its emission too.
-                const TimeNs step_started_ns = clock_.now_ns();
-                // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
-                if (local.next_wake_ns > 0) {
-                    local.late_ns.push_back(step_started_ns - local.next_wake_ns);
-                    lateness_.record(local.node->name(), local.next_wake_ns, step_started_ns);
+            const bool due = local.next_wake_ns <= now;
+            if (!due && !local.node->has_unread_input()) continue;
+            // Late by when its step began: a long step of a node before it in
+            // this pass delays its emission too.
+            const TimeNs step_started_ns = clock_.now_ns();
+            const bool counts_own = local.node->reports_own_emissions();
+            // The wake at t = 0 follows the start-up (activation, the start tick): not scheduling jitter.
+            if (due && !counts_own && local.next_wake_ns > 0) record_emission(local, local.next_wake_ns, step_started_ns);
+            const TimeNs wake = local.node->step(now);
+            local.next_wake_ns = due ? wake : std::min(local.next_wake_ns, wake);
+            local.step_ns.push_back(clock_.now_ns() - step_started_ns);
+            if (counts_own) {
+                for (const TimeNs deadline_ns : local.node->take_emitted_deadlines()) {
+                    if (deadline_ns > 0) record_emission(local, deadline_ns, step_started_ns);
                 }
-                local.next_wake_ns = local.node->step(now);
-                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
-            } else if (local.node->has_unread_input()) {
-                const TimeNs step_started_ns = clock_.now_ns();
-                local.next_wake_ns = std::min(local.next_wake_ns, local.node->step(now));
-                local.step_ns.push_back(clock_.now_ns() - step_started_ns);
             }
         }
         if (after_step_) after_step_(now);
@@ -137,6 +201,11 @@ void RealtimeMaster::run_until(TimeNs end_ns) {
         const TimeNs wake = std::min(next, clock_.now_ns() + std::chrono::nanoseconds(kLivenessSlice).count());
         dds_.wait_for_arrival(arrivals_seen, clock_.steady_time(wake));
     }
+}
+
+void RealtimeMaster::record_emission(Local& local, TimeNs deadline_ns, TimeNs emitted_ns) {
+    local.late_ns.push_back(std::max<TimeNs>(0, emitted_ns - deadline_ns));
+    lateness_.record(local.node->name(), deadline_ns, emitted_ns);
 }
 
 void RealtimeMaster::shutdown(bool after_failure) noexcept {

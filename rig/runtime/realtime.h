@@ -67,8 +67,36 @@ std::string raise_thread_to_realtime(std::thread& thread, int priority);
 // computes for tens of milliseconds, such as a camera rendering its next
 // frame. At the loop's priority it would hold a core the loop needs; below
 // it, it takes what the loop leaves. Harmless when the thread was not
-// real-time. "" when done, else why not.
-std::string drop_to_time_sharing();
+// real-time. `nice`, when given (-20 ... 19), weighs the thread against the
+// machine's other time-sharing work (below 0, which needs CAP_SYS_NICE: a
+// worker whose results have deadlines); without it the thread keeps the nice
+// value it inherited. "" when done, else why not.
+std::string drop_to_time_sharing(std::optional<int> nice = std::nullopt);
+
+// The weight of this process's session against the machine's other sessions
+// while a real-time run lasts. With the kernel's autogroups (Debian's default,
+// /proc/sys/kernel/sched_autogroup_enabled), CFS shares the CPUs between
+// sessions first and between threads of a session second: a thread's nice
+// value only weighs against threads of its own session, and a session beside
+// three others building gets a quarter of the machine, whatever its threads
+// ask. The run's time-sharing work with deadlines (the cameras' rendering, the
+// controller it started) is in this session, so the session's autogroup gets
+// `nice` while a guard lives and its nice value from before after the last
+// one ends (concurrent real-time cases share one autogroup). When autogroups
+// are off or the write is refused, nothing changes and detail() says why.
+class SessionCpuWeight {
+public:
+    explicit SessionCpuWeight(int nice);
+    ~SessionCpuWeight();
+    SessionCpuWeight(const SessionCpuWeight&) = delete;
+    SessionCpuWeight& operator=(const SessionCpuWeight&) = delete;
+    // e.g. "session autogroup nice -10 (was 0)", or why not.
+    const std::string& detail() const { return detail_; }
+
+private:
+    bool raised_ = false;
+    std::string detail_;
+};
 
 class RealtimeMaster {
 public:
@@ -124,6 +152,8 @@ private:
         std::vector<TimeNs> late_ns;
         std::vector<TimeNs> step_ns;
     };
+    void record_emission(Local& local, TimeNs deadline_ns, TimeNs emitted_ns);
+
     DdsContext& dds_;
     LockstepMaster remotes_;
     RealtimeClock clock_;

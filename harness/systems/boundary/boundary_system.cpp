@@ -28,8 +28,9 @@ constexpr const char* kJobFile = "job.yaml";
 class BoundaryNodes final : public SystemNodes {
 public:
     BoundaryNodes(const BoundarySections& own, const BoundaryWorld& world, std::uint64_t seed, const WiringSpec& wiring,
-                  BenchWires& wires)
-        : plant_(world.kinematics, emulators::PwmNozzleValves(world.valves, own.flow_table_or_paper()), own.spray,
+                  ClockMode clock, BenchWires& wires)
+        : clock_(clock),
+          plant_(world.kinematics, emulators::PwmNozzleValves(world.valves, own.flow_table_or_paper()), own.spray,
                  kIdleTruthRateHz),
           ad300_(world.kinematics, world.ad300),
           laser_(world.kinematics, world.laser) {
@@ -47,7 +48,7 @@ public:
                 cameras_.push_back(std::make_unique<CameraNode>(world.kinematics, *world.crop,
                                                                 camera == 0 ? world.vision->left : world.vision->right,
                                                                 seed, camera, nozzles, right_m,
-                                                                seconds_to_ns(world.vision->calibration_until_s)));
+                                                                seconds_to_ns(world.vision->calibration_until_s), clock));
                 // The report shows each camera's frame from the middle of the run.
                 cameras_.back()->keep_frame_at(world.end_ns / 2);
                 all_.push_back(cameras_.back().get());
@@ -67,6 +68,8 @@ public:
         nlohmann::json report_frames = nlohmann::json::array();
         for (std::size_t c = 0; c < cameras_.size(); ++c) {
             facts.system[cameras_[c]->name() + "_frames"] = cameras_[c]->frames_rendered();
+            // Real time: whether the rendering thread got the weight its deadlines need.
+            if (clock_ == ClockMode::realtime) facts.system[cameras_[c]->name() + "_rendering"] = cameras_[c]->render_scheduling();
             const std::string file = "frame-" + cameras_[c]->name() + ".png";
             if (const std::optional<std::uint64_t> number = cameras_[c]->write_report_frame(case_dir / file)) {
                 report_frames.push_back({{"camera", c}, {"frame_number", *number}, {"file", file}});
@@ -77,6 +80,7 @@ public:
     }
 
 private:
+    ClockMode clock_;
     BoundaryPlantNode plant_;
     Ad300Node ad300_;
     L4LaserNode laser_;
@@ -172,7 +176,7 @@ std::vector<KeySignal> boundary_key_signals(const RecordedTrace& trace) {
 class BoundaryRun final : public SystemRun {
 public:
     BoundaryRun(const CaseSpec& spec, std::uint64_t seed)
-        : own_(boundary_sections(spec)), wiring_(spec.wiring), seed_(seed), world_(own_, seed) {}
+        : own_(boundary_sections(spec)), wiring_(spec.wiring), clock_(spec.mode), seed_(seed), world_(own_, seed) {}
 
     TimeNs end_ns() const override { return world_.end_ns; }
 
@@ -208,12 +212,13 @@ public:
     }
 
     std::unique_ptr<SystemNodes> make_nodes(BenchWires& wires) override {
-        return std::make_unique<BoundaryNodes>(own_, world_, seed_, wiring_, wires);
+        return std::make_unique<BoundaryNodes>(own_, world_, seed_, wiring_, clock_, wires);
     }
 
 private:
     const BoundarySections& own_;
     WiringSpec wiring_;
+    ClockMode clock_;
     std::uint64_t seed_;
     BoundaryWorld world_;
 };

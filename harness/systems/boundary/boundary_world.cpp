@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 
 #include "emulators/malformed_command.h"
@@ -174,7 +175,8 @@ std::string sha256_hex(const std::vector<std::uint8_t>& bytes) {
 
 CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
                        emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
-                       std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns)
+                       std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns,
+                       ClockMode clock)
     : name_(camera_index == 0 ? "camera_left" : "camera_right"),
       kinematics_(kinematics),
       emulator_(params, seed, static_cast<std::uint64_t>(camera_index), name_),
@@ -183,7 +185,8 @@ CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field
       nozzle_right_m_(std::move(nozzle_right_m)),
       frame_rate_hz_(params.frame_rate_hz),
       calibration_until_ns_(calibration_until_ns),
-      render_crop_(crop.params(), crop.seed()) {
+      render_crop_(crop.params(), crop.seed()),
+      clock_(clock) {
     // The operator lays the green board in front of the camera (where it was
     // designed to sit: a turned camera sees it turned) and a red board over
     // each nozzle.
@@ -191,15 +194,36 @@ CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field
     boards_.nozzle_right_m = nozzle_right_m_;
 }
 
+CameraNode::~CameraNode() { shutdown(); }
+
 void CameraNode::configure(DdsContext& dds) {
+    dds_ = &dds;
     frame_writer_ = std::make_unique<Writer<msg::CameraFrame>>(
         dds, camera_index_ == 0 ? topics::kCameraLeftFrame : topics::kCameraRightFrame);
     truth_writer_ = std::make_unique<Writer<msg::CameraViewTruth>>(dds, topics::kCameraViewTruth);
-    // Frame 0 is rendered before time starts: the first frame builds the crop
-    // truth's tiles in view, and a real-time run must not stall at t = 0 on it.
-    std::promise<Rendered> first;
-    first.set_value(render(0));
-    ahead_.emplace_back(0, first.get_future());
+    const auto depth = static_cast<std::size_t>(std::max(2.0, std::ceil(kRenderAheadS * frame_rate_hz_)));
+    ahead_ = std::make_unique<WorkAhead<Rendered>>(
+        [this](std::uint64_t k) { return render(k); }, depth,
+        [this] {
+            // Started by the loop's thread: at the real-time loop's SCHED_FIFO
+            // priority, or on a lockstep case's leased CPU (rig/host/cpu_lease.h).
+            // Rendering runs beside the loop, on any CPU, below it: it must not
+            // take the loop's core. In real time its frames have deadlines, so
+            // it goes before the run's other time-sharing threads.
+            const std::string refused =
+                drop_to_time_sharing(clock_ == ClockMode::realtime ? std::optional<int>(kRealtimeRenderNice) : std::nullopt);
+            leave_leased_cpu();
+            const std::lock_guard lock(render_scheduling_mutex_);
+            render_scheduling_ = refused.empty() ? describe_thread_placement() : refused;
+        },
+        [this] {
+            // Real time: a frame left for later is due as soon as it is rendered.
+            if (clock_ == ClockMode::realtime) dds_->notify_data_arrived();
+        });
+    // Frame 0 is due at t = 0, before any wake of the loop could wait for it:
+    // rendered before time starts (the first frame also builds the crop
+    // truth's tiles in view).
+    ahead_->wait_until_next_ready();
 }
 
 TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
@@ -208,9 +232,6 @@ TimeNs CameraNode::frame_time_ns(std::uint64_t k) const {
 }
 
 CameraNode::Rendered CameraNode::render(std::uint64_t k) const {
-    // Two frames may be in flight: one renders at a time. Which comes first
-    // does not matter: the crop truth is the same whatever is looked at first.
-    const std::lock_guard<std::mutex> one_at_a_time(render_mutex_);
     Rendered out;
     const TimeNs t_ns = frame_time_ns(k);
     out.truth = kinematics_.truth_at(ns_to_seconds(t_ns));
@@ -239,25 +260,25 @@ CameraNode::Rendered CameraNode::render(std::uint64_t k) const {
     return out;
 }
 
+std::string CameraNode::render_scheduling() const {
+    const std::lock_guard lock(render_scheduling_mutex_);
+    return render_scheduling_;
+}
+
+bool CameraNode::has_unread_input() const { return frame_owed_ && ahead_ && ahead_->next_ready(); }
+
 TimeNs CameraNode::step(TimeNs now_ns) {
+    frame_owed_ = false;
     while (frame_time_ns(frame_count_) <= now_ns) {
         const TimeNs t_ns = frame_time_ns(frame_count_);
-        // The frame rendered ahead (an exception there comes out here), or now.
-        // Keep the next frames rendering (an exception there comes out at its get()).
-        for (std::uint64_t k = ahead_.empty() ? frame_count_ : ahead_.back().first + 1; k <= frame_count_ + kRenderAhead; ++k) {
-            ahead_.emplace_back(k, std::async(std::launch::async, [this, k] {
-                // A thread of its own, started by the loop's: at the real-time
-                // loop's SCHED_FIFO priority, or on a lockstep case's leased CPU
-                // (rig/host/cpu_lease.h). Rendering runs beside the loop, on any
-                // CPU, below it: it must not take the loop's core.
-                drop_to_time_sharing();
-                leave_leased_cpu();
-                return render(k);
-            }));
+        if (clock_ == ClockMode::realtime && !ahead_->next_ready()) {
+            // Late on its own: the rendering thread wakes the loop when the
+            // frame is done (has_unread_input), and nothing else waits for it.
+            frame_owed_ = true;
+            return kNever;
         }
-        if (ahead_.front().first != frame_count_) throw std::logic_error(name_ + ": frames rendered out of order");
-        Rendered rendered = ahead_.front().second.get();
-        ahead_.pop_front();
+        if (ahead_->next_index() != frame_count_) throw std::logic_error(name_ + ": frames rendered out of order");
+        Rendered rendered = ahead_->take();  // an exception of the rendering comes out here
 
         const field2d::SprayerTruth& truth = rendered.truth;
         const std::optional<rig::camera::RgbImage>& image = rendered.image;
@@ -271,13 +292,20 @@ TimeNs CameraNode::step(TimeNs now_ns) {
             frame.frame_number(static_cast<std::uint32_t>(frame_count_));
             frame.width_px(static_cast<std::uint16_t>(image->width));
             frame.height_px(static_cast<std::uint16_t>(image->height));
-            frame.rgb(image->bytes);
+            frame.rgb(std::move(rendered.image->bytes));  // the frame's last use: no 2.8 MB copy
             frame_writer_->publish(frame);
         }
         truth_writer_->publish(rendered.view);
+        if (reports_own_emissions()) emitted_deadlines_.push_back(t_ns);
         ++frame_count_;
     }
     return frame_time_ns(frame_count_);
+}
+
+void CameraNode::shutdown() {
+    // Stops the rendering thread before anything it uses (the DDS context it
+    // wakes, this node's members) goes away.
+    ahead_.reset();
 }
 
 std::optional<std::uint64_t> CameraNode::write_report_frame(const std::filesystem::path& file) const {

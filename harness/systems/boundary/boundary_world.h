@@ -14,13 +14,12 @@
 //                      its nozzles' ROIs on truth/camera_view.
 // A pure function of the case and the seed: same seed, same trace.
 #include <cstdint>
-#include <deque>
 #include <filesystem>
-#include <future>
-#include <mutex>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "emulators/ad300_receiver.h"
@@ -30,6 +29,7 @@
 #include "emulators/pwm_nozzle_valves.h"
 #include "emulators/field2d/crop_cover_map.h"
 #include "emulators/vision/camera_emulator.h"
+#include "rig/runtime/work_ahead.h"
 #include "harness/systems/boundary/boundary_case.h"
 #include "rig/runtime/dds_context.h"
 #include "rig/runtime/node.h"
@@ -116,29 +116,44 @@ private:
 // is dead with no_frame), and on truth/camera_view the true cover D of each of
 // its nozzles' Sec. 2.1 ROIs (from the plant's true nozzle points; the
 // controller's ROIs are its own estimate of these) with the frame's SHA-256.
-// Rendering (30-60 ms a frame, more where new crop tiles are built) runs two
-// frames ahead, on threads of its own:
-// what a frame shows depends on the plant's boom pose at its instant, which
-// the route fixes in advance (the controller drives no part of it), so frame
-// k + 1 and k + 2 are rendered while the run goes on to them. The frame is the same either
-// way (a pure function of case, seed and frame number); the real-time loop
-// then does not stall on it, and lockstep runs render beside the rounds. The
-// thread reads its own copy of the crop truth (the map builds its raster
-// tiles on first use and is not shared between threads), and also counts the
-// true cover under the ROIs there: a real-time step only publishes.
+// Rendering (30-60 ms a frame, more where new crop tiles are built) runs
+// ahead on one thread of its own (rig/runtime/work_ahead.h), up to
+// kRenderAheadS of frames: what a frame shows depends on the plant's boom pose
+// at its instant, which the route fixes in advance (the controller drives no
+// part of it). The frame is the same either way (a pure function of case, seed
+// and frame number). The thread reads its own copy of the crop truth (the map
+// builds its raster tiles on first use and is not shared between threads), and
+// also counts the true cover under the ROIs there: a step only publishes.
+//
+// When a frame is due and not rendered yet: in lockstep the step waits for
+// it (the frame belongs to its round). In real time it does not: a camera
+// that falls behind is late on its own (Node::reports_own_emissions), its
+// frame leaves when rendered and its lateness counts against the camera, and
+// every other device keeps its time.
 class CameraNode final : public Node {
 public:
     // camera_index 0 = left (device/camera_left/frame), 1 = right; `nozzles`
     // the nozzle numbers it sees; nozzle_right_m each one's place across the boom.
     // Frames exposed before calibration_until_ns show Sec. 2.2.1's boards
     // (a green board in front of the camera, a red one over each of its nozzles).
+    // `clock`: the case's mode, which says whether a step may leave a frame
+    // that is not rendered yet for later (real time) or waits for it (lockstep).
     CameraNode(const field2d::SprayerKinematics& kinematics, const field2d::CropCoverMap& crop,
                emulators::vision::CameraEmulatorParams params, std::uint64_t seed, int camera_index,
-               std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns = 0);
+               std::vector<int> nozzles, std::vector<double> nozzle_right_m, TimeNs calibration_until_ns = 0,
+               ClockMode clock = ClockMode::lockstep);
+    ~CameraNode() override;
     const std::string& name() const override { return name_; }
     void configure(DdsContext& dds) override;
     TimeNs step(TimeNs now_ns) override;
+    bool has_unread_input() const override;
+    bool reports_own_emissions() const override { return clock_ == ClockMode::realtime; }
+    std::vector<TimeNs> take_emitted_deadlines() override { return std::exchange(emitted_deadlines_, {}); }
+    void shutdown() override;
     std::uint64_t frames_rendered() const { return frame_count_; }
+    // How the rendering thread was scheduled ("CPUs 0-1 of 2, SCHED_OTHER, nice -10"),
+    // or what was refused; "" before it started.
+    std::string render_scheduling() const;
     // Keeps a copy of the first frame exposed at or after `at_ns`, for the
     // report: the frame with the ROIs drawn (write_report_frame).
     void keep_frame_at(TimeNs at_ns) { keep_at_ns_ = at_ns; }
@@ -167,12 +182,27 @@ private:
     double frame_rate_hz_;
     TimeNs calibration_until_ns_;
     emulators::vision::CalibrationBoards boards_;
-    field2d::CropCoverMap render_crop_;  // the rendering threads' own copy of the crop truth ...
-    mutable std::mutex render_mutex_;    // ... which one of them uses at a time (its tile cache is not thread-safe)
-    // Frames being rendered, in frame order: the next kRenderAhead after the
-    // one last published, each on its own thread.
-    static constexpr std::uint64_t kRenderAhead = 2;
-    std::deque<std::pair<std::uint64_t, std::future<Rendered>>> ahead_;
+    field2d::CropCoverMap render_crop_;  // the rendering thread's own copy of the crop truth
+    ClockMode clock_;
+    // How far ahead frames are rendered: enough to ride out the rendering
+    // thread losing its CPU for a while on a busy machine (rig/runtime/work_ahead.h);
+    // at the cases' 5 fps, 10 frames (28 MB at 1280 x 720).
+    static constexpr double kRenderAheadS = 2.0;
+    // The rendering thread's nice value in real time. CFS shares a CPU by
+    // weight: nice -10 weighs 9548 against 1024 at nice 0, so the rendering
+    // goes before the run's other time-sharing threads (lockstep cases of the
+    // same `rig run`, its DDS threads) when it has a frame to render, and
+    // sleeps when it is ahead, so they lose nothing while it does. Against
+    // other sessions' work (a build) the session's own weight counts
+    // (SessionCpuWeight, harness/run/case_loop.cpp).
+    static constexpr int kRealtimeRenderNice = -10;
+    std::unique_ptr<WorkAhead<Rendered>> ahead_;
+    mutable std::mutex render_scheduling_mutex_;
+    std::string render_scheduling_;  // how the rendering thread runs, or why not as asked (a run's facts)
+    // Real time: the last step left a due frame for later (not rendered yet).
+    bool frame_owed_ = false;
+    DdsContext* dds_ = nullptr;  // the rendering thread wakes the real-time loop through it
+    std::vector<TimeNs> emitted_deadlines_;
     std::uint64_t frame_count_ = 0;
     std::optional<TimeNs> keep_at_ns_;
     std::optional<rig::camera::RgbImage> kept_frame_;
