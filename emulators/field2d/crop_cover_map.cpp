@@ -317,13 +317,13 @@ void CropCoverMap::rasterise(Tile& tile, std::int64_t tile_east, std::int64_t ti
                         const Span sure = leaf_shape.slice(cy, half_width - kSureM);
                         const int i_first = std::max(0, static_cast<int>(std::floor(maybe.low / kCellM - 0.5)));
                         const int i_last = std::min(kTileCells - 1, static_cast<int>(std::ceil(maybe.high / kCellM - 0.5)));
-                        std::uint8_t* row = tile.plant.data() + static_cast<std::size_t>(j) * kTileCells;
+                        std::uint8_t* tile_row = tile.plant.data() + static_cast<std::size_t>(j) * kTileCells;
                         for (int i = i_first; i <= i_last; ++i) {
                             const double cx = (i + 0.5) * kCellM;
                             if (cx > sure.low && cx < sure.high) {
-                                row[i] = kPlantCell;
+                                tile_row[i] = kPlantCell;
                             } else if (segment_distance_sq(cx, cy, bx, by, tx, ty) <= half_width * half_width) {
-                                row[i] = kPlantCell;
+                                tile_row[i] = kPlantCell;
                             }
                         }
                     }
