@@ -343,8 +343,12 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     // Headers over this object's own tables, only read (OpenCV has no const Mat over const data).
     const int table_width = width + kNoiseShifts - 1;
     const int table_height = height + kNoiseShifts - 1;
-    const cv::Mat noise_up(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_up_.data()));
-    const cv::Mat noise_down(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_down_.data()));
+    cv::Mat noise_up;
+    cv::Mat noise_down;
+    if (!noise_up_.empty()) {
+        noise_up = cv::Mat(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_up_.data()));
+        noise_down = cv::Mat(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_down_.data()));
+    }
     const cv::Mat sky_pixels(height, width, CV_8UC1, const_cast<std::uint8_t*>(sky_pixels_.data()));
     // The maps count from the view's first cell: remap reads the window from there.
     cv::Mat view;
