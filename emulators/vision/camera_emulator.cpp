@@ -40,6 +40,17 @@ constexpr float kFarCells = 16'000.0F;
 constexpr int kBandSamples = 1 << 16;
 // Noise: a frame's window into the table starts at one of 256 x 256 shifts.
 constexpr int kNoiseShifts = 256;
+// Colour and noise are summed in 1/64 DN and rounded once, as a sensor's ADC
+// sees light plus noise: rounding the lit colour on its own first would shift
+// a colour by up to half a DN everywhere (the low-sun leaf's ExG of 42 sits
+// at the controller's floor of 40, where that shows).
+constexpr double kSubDn = 64.0;
+
+// A lit colour in 1/64 DN. Above 511 DN (the most 16 bits hold) it is held
+// at 511: noise (at most 3.47 x 50 DN) cannot bring it below 255 there, so
+// the frame still reads 255, as it would unheld; and the sum saturates at
+// 32767 (511.98 DN), which reads 255 too.
+std::int16_t sub_dn(double dn) { return static_cast<std::int16_t>(std::lround(std::clamp(dn, 0.0, 511.0) * kSubDn)); }
 
 void require_gains(const ChannelGains& gains, const std::string& where, const char* which) {
     const std::string prefix = where + "." + which;
@@ -89,9 +100,6 @@ struct LitColours {
     double red_gain;
     double green_gain;
     double blue_gain;
-    Rgb lit(double red, double green, double blue) const {
-        return Rgb{to_byte(red * red_gain), to_byte(green * green_gain), to_byte(blue * blue_gain)};
-    }
 };
 
 LitColours lit_colours(const CameraEmulatorParams& params) {
@@ -204,13 +212,11 @@ CameraEmulator::CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, 
     if (params_.noise_sd_dn > 0.0) {
         const std::size_t table_values =
             3U * static_cast<std::size_t>(width + kNoiseShifts - 1) * static_cast<std::size_t>(height + kNoiseShifts - 1);
-        noise_up_.resize(table_values);
-        noise_down_.resize(table_values);
+        noise_.resize(table_values);
         const std::uint64_t table_key = rig::field2d::hash_finalise(noise_key_ ^ 0x7ab1e000ULL);
         for (std::size_t i = 0; i < table_values; ++i) {
             const double draw = params_.noise_sd_dn * unit_noise(rig::field2d::hash_finalise(table_key + i));
-            noise_up_[i] = to_byte(draw);
-            noise_down_[i] = to_byte(-draw);
+            noise_[i] = static_cast<std::int16_t>(std::lround(draw * kSubDn));
         }
     }
 }
@@ -325,16 +331,18 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
 
     // Colour by cover (0 soil .. 255 plant) under this camera's light.
     const LitColours light = lit_colours(params_);
-    cv::Mat cover_to_rgb(1, 256, CV_8UC3);
+    cv::Mat cover_to_rgb(1, 256, CV_16SC3);
     for (int cover = 0; cover < 256; ++cover) {
         const double plant_share = cover / 255.0;
         const Rgb soil = params_.soil_rgb;
         const Rgb plant = params_.plant_rgb;
-        const Rgb seen = light.lit(soil.r + plant_share * (plant.r - soil.r), soil.g + plant_share * (plant.g - soil.g),
-                                   soil.b + plant_share * (plant.b - soil.b));
-        cover_to_rgb.at<cv::Vec3b>(0, cover) = cv::Vec3b(seen.r, seen.g, seen.b);
+        cover_to_rgb.at<cv::Vec3s>(0, cover) =
+            cv::Vec3s(sub_dn((soil.r + plant_share * (plant.r - soil.r)) * light.red_gain),
+                      sub_dn((soil.g + plant_share * (plant.g - soil.g)) * light.green_gain),
+                      sub_dn((soil.b + plant_share * (plant.b - soil.b)) * light.blue_gain));
     }
-    const Rgb sky = light.lit(params_.sky_rgb.r, params_.sky_rgb.g, params_.sky_rgb.b);
+    const cv::Scalar sky(sub_dn(params_.sky_rgb.r * light.red_gain), sub_dn(params_.sky_rgb.g * light.green_gain),
+                         sub_dn(params_.sky_rgb.b * light.blue_gain));
 
     // This frame's window into the noise table.
     const std::uint64_t frame_key = rig::field2d::hash_finalise(noise_key_ ^ rig::field2d::hash_finalise(frame_index));
@@ -343,12 +351,8 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     // Headers over this object's own tables, only read (OpenCV has no const Mat over const data).
     const int table_width = width + kNoiseShifts - 1;
     const int table_height = height + kNoiseShifts - 1;
-    cv::Mat noise_up;
-    cv::Mat noise_down;
-    if (!noise_up_.empty()) {
-        noise_up = cv::Mat(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_up_.data()));
-        noise_down = cv::Mat(table_height, table_width, CV_8UC3, const_cast<std::uint8_t*>(noise_down_.data()));
-    }
+    cv::Mat noise;
+    if (!noise_.empty()) noise = cv::Mat(table_height, table_width, CV_16SC3, const_cast<std::int16_t*>(noise_.data()));
     const cv::Mat sky_pixels(height, width, CV_8UC1, const_cast<std::uint8_t*>(sky_pixels_.data()));
     // The maps count from the view's first cell: remap reads the window from there.
     cv::Mat view;
@@ -370,6 +374,8 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     cv::Mat fixed_fraction;
     cv::Mat samples;
     cv::Mat cover;
+    cv::Mat cover_rgb;
+    cv::Mat lit;
     Eigen::ArrayXf row_x(width + 1);
     Eigen::ArrayXf row_y(width + 1);
     Eigen::ArrayXf sample_x(width);
@@ -425,15 +431,12 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
         } else {
             cover = cv::Mat::zeros(rows, width, CV_8UC1);
         }
+        cv::cvtColor(cover, cover_rgb, cv::COLOR_GRAY2RGB);
+        cv::LUT(cover_rgb, cover_to_rgb, lit);
+        if (any_sky_) lit.setTo(sky, sky_pixels.rowRange(v0, v0 + rows));
+        if (!noise_.empty()) cv::add(lit, noise(cv::Rect(noise_u, noise_v + v0, width, rows)), lit);
         cv::Mat band = frame.rowRange(v0, v0 + rows);
-        cv::cvtColor(cover, band, cv::COLOR_GRAY2RGB);
-        cv::LUT(band, cover_to_rgb, band);
-        if (any_sky_) band.setTo(cv::Scalar(sky.r, sky.g, sky.b), sky_pixels.rowRange(v0, v0 + rows));
-        if (!noise_up_.empty()) {
-            const cv::Rect in_table(noise_u, noise_v + v0, width, rows);
-            cv::add(band, noise_up(in_table), band);
-            cv::subtract(band, noise_down(in_table), band);
-        }
+        lit.convertTo(band, CV_8U, 1.0 / kSubDn);  // rounded (exact in binary: a power of two) and clipped to 0-255
     }
     if (faults.blur_radius_px > 0) box_blur(image, faults.blur_radius_px);
     return image;

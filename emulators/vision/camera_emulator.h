@@ -199,12 +199,10 @@ private:
     std::vector<std::uint8_t> sky_pixels_;
     bool any_sky_ = false;
     std::vector<std::size_t> outline_corners_;
-    // The noise table: per channel, the positive and the negative part of a
-    // rounded N(0, noise_sd_dn) draw (a saturating add then subtract is the
-    // clipped sum), (width + kNoiseShifts - 1) x (height + kNoiseShifts - 1)
-    // pixels; empty without noise.
-    std::vector<std::uint8_t> noise_up_;
-    std::vector<std::uint8_t> noise_down_;
+    // The noise table: N(0, noise_sd_dn) draws per channel in 1/64 DN,
+    // (width + kNoiseShifts - 1) x (height + kNoiseShifts - 1) pixels; empty
+    // without noise.
+    std::vector<std::int16_t> noise_;
     // The block of the crop's truth render() samples.
     struct CoverWindow {
         std::uint64_t crop_identity = 0;  // 0: holds nothing
