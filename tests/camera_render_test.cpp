@@ -1,6 +1,7 @@
 // The camera emulator's renderer (emulators/vision/camera_emulator.*) against
 // the crop truth it draws: a pixel that sees one kind of ground only has that
-// ground's colour, a leaf edge gives mixed pixels on the soil-plant line, the
+// ground's colour, a leaf edge gives mixed pixels on the soil-plant line when
+// a pixel's footprint is sampled n x n (one sample: soil or plant), the
 // noise is seeded (same frame, same bytes; another seed, other noise) and of
 // the configured size, and where the renderer happens to keep its block of the
 // truth never shows in a frame.
@@ -79,9 +80,21 @@ void expect_matches_truth(int samples_per_axis) {
 TEST(CameraRender, OneSampleMatchesCropTruth) { expect_matches_truth(1); }
 TEST(CameraRender, FootprintSamplesMatchCropTruth) { expect_matches_truth(2); }
 
-TEST(CameraRender, LeafEdgesGiveMixedPixelsOnTheSoilPlantLine) {
+TEST(CameraRender, OneSampleGivesNoMixedPixels) {
     const CropCoverMap crop(CropCoverParams{}, 4);
     const CameraEmulator camera(noiseless(1), 4, 0, "left");
+    const auto image = camera.render(crop, BoomPose{{0.0, 0.0}, 0.0, 0.5}, 0);
+    for (int v = 0; v < image->height; ++v) {
+        for (int u = 0; u < image->width; ++u) {
+            const Rgb seen = image->at(u, v);
+            ASSERT_TRUE(same(seen, camera.params().soil_rgb) || same(seen, camera.params().plant_rgb)) << u << ", " << v;
+        }
+    }
+}
+
+TEST(CameraRender, FootprintSamplesGiveMixedPixelsOnTheSoilPlantLine) {
+    const CropCoverMap crop(CropCoverParams{}, 4);
+    const CameraEmulator camera(noiseless(2), 4, 0, "left");
     const auto image = camera.render(crop, BoomPose{{0.0, 0.0}, 0.0, 0.5}, 0);
     ASSERT_TRUE(image.has_value());
     const Rgb soil = camera.params().soil_rgb;
@@ -103,6 +116,7 @@ TEST(CameraRender, LeafEdgesGiveMixedPixelsOnTheSoilPlantLine) {
         }
     }
     // Leaves 8 mm wide under pixels of 1.7-3.6 mm: a good share of the plant pixels are edges.
+    // (With 2 x 2 samples a mix is a quarter, a half or three quarters.)
     EXPECT_GT(mixed, 10'000);
 }
 

@@ -371,7 +371,6 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     cv::Mat map_x(band_rows * n, width * n, CV_32FC1);
     cv::Mat map_y(band_rows * n, width * n, CV_32FC1);
     cv::Mat fixed_xy;
-    cv::Mat fixed_fraction;
     cv::Mat samples;
     cv::Mat cover;
     cv::Mat cover_rgb;
@@ -421,8 +420,11 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
                     Strided(map_y.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_y;
                 }
             }
-            cv::convertMaps(map_x.rowRange(0, sample_rows), map_y.rowRange(0, sample_rows), fixed_xy, fixed_fraction, CV_16SC2, false);
-            cv::remap(view, samples, fixed_xy, fixed_fraction, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+            // Each sample reads the truth cell it falls in (the nearest cell
+            // centre), as render_scene's samples do: a pixel's mix at a leaf
+            // edge comes from its n x n samples, not from blurring the truth.
+            cv::convertMaps(map_x.rowRange(0, sample_rows), map_y.rowRange(0, sample_rows), fixed_xy, cv::noArray(), CV_16SC2, true);
+            cv::remap(view, samples, fixed_xy, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
             if (n > 1) {
                 cv::resize(samples, cover, cv::Size(width, rows), 0.0, 0.0, cv::INTER_AREA);  // the mean of n x n
             } else {
