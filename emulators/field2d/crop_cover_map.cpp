@@ -1,7 +1,9 @@
 #include "emulators/field2d/crop_cover_map.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -23,6 +25,8 @@ constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
 constexpr std::size_t kMaxCachedTiles = 1024;
 // Plants are drawn per row cell of this length along the row.
 constexpr double kRowCellM = 0.25;
+// rasterise()'s margin between a leaf's surely-inside and surely-outside cells.
+constexpr double kSureM = 1e-9;
 
 // Poisson by inversion of its CDF (mean at most 250 here, so exp(-mean) stays a normal double).
 int poisson(HashStream& stream, double mean) {
@@ -42,6 +46,15 @@ int poisson(HashStream& stream, double mean) {
 std::int64_t floor_to_int(double value) {
     const auto truncated = static_cast<std::int64_t>(value);
     return static_cast<double>(truncated) > value ? truncated - 1 : truncated;
+}
+
+// Cells within 1000 km of the origin (is_plant's bound): far inside int64, and
+// a tile index fits the 32 bits tile_key gives it.
+constexpr std::int64_t kMaxCellIndex = 1'000'000'000;
+
+std::uint64_t next_map_identity() {
+    static std::atomic<std::uint64_t> count{0};
+    return ++count;
 }
 
 std::uint64_t tile_key(std::int64_t east, std::int64_t north) {
@@ -65,6 +78,64 @@ double segment_distance_sq(double px, double py, double ax, double ay, double bx
     const double ey = py - (ay + t * dy);
     return ex * ex + ey * ey;
 }
+
+// The x extent, at height y, of the points within `radius` of the segment a-b
+// (a capsule: convex, so its slice is one interval, the union of the slices of
+// its two end discs and its middle rectangle). Empty (low > high) if none.
+struct Span {
+    double low = 1e300;
+    double high = -1e300;
+    void cover(double from, double to) {
+        if (from > to) return;
+        low = std::min(low, from);
+        high = std::max(high, to);
+    }
+};
+
+// A leaf: the points within some radius of the segment a-b.
+struct Capsule {
+    double ax, ay, bx, by;
+    double ux, uy, length;  // unit vector a -> b and the segment's length
+
+    Capsule(double from_x, double from_y, double to_x, double to_y)
+        : ax(from_x), ay(from_y), bx(to_x), by(to_y), length(std::hypot(to_x - from_x, to_y - from_y)) {
+        ux = length > 0.0 ? (bx - ax) / length : 0.0;
+        uy = length > 0.0 ? (by - ay) / length : 0.0;
+    }
+
+    // The x extent at height y of the points within `radius` (a capsule is
+    // convex, so its slice is one interval: the union of the slices of its
+    // two end discs and its middle rectangle). Empty (low > high) if none.
+    Span slice(double y, double radius) const {
+        Span span;
+        for (const auto& [cx, cy] : {std::pair{ax, ay}, std::pair{bx, by}}) {
+            const double dy = y - cy;
+            if (std::abs(dy) <= radius) {
+                const double half = std::sqrt(radius * radius - dy * dy);
+                span.cover(cx - half, cx + half);
+            }
+        }
+        if (length <= 0.0) return span;
+        // The rectangle: 0 <= (p - a).u <= length and |(p - a).n| <= radius,
+        // n square to u, each linear in x at this y.
+        double low = -1e300;
+        double high = 1e300;
+        auto within = [&](double slope, double offset, double lo, double hi) {
+            if (std::abs(slope) < 1e-12) {
+                if (offset < lo || offset > hi) high = -1e300;
+                return;
+            }
+            const double x1 = (lo - offset) / slope;
+            const double x2 = (hi - offset) / slope;
+            low = std::max(low, std::min(x1, x2));
+            high = std::min(high, std::max(x1, x2));
+        };
+        within(ux, -ax * ux + (y - ay) * uy, 0.0, length);
+        within(-uy, ax * uy + (y - ay) * ux, -radius, radius);
+        span.cover(low, high);
+        return span;
+    }
+};
 
 bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
     const double d1 = cross(b - a, c - a);
@@ -92,6 +163,7 @@ bool inside_quad(const std::array<Vec2, 4>& q, double x, double y) {
 }  // namespace
 
 struct CropCoverMap::Tile {
+    // kPlantCell or 0 per cell, row-major from the tile's south-west cell.
     std::vector<std::uint8_t> plant = std::vector<std::uint8_t>(static_cast<std::size_t>(kTileCells) * kTileCells, 0);
 };
 
@@ -121,7 +193,8 @@ void validate(const CropCoverParams& p) {
     require(finite_within(p.leaf_width_m, 0.001, 0.05), "leaf_width_m", p.leaf_width_m, "[0.001, 0.05] m");
 }
 
-CropCoverMap::CropCoverMap(CropCoverParams params, std::uint64_t seed) : params_(std::move(params)), seed_(seed) {
+CropCoverMap::CropCoverMap(CropCoverParams params, std::uint64_t seed)
+    : params_(std::move(params)), seed_(seed), identity_(next_map_identity()) {
     validate(params_);
 }
 CropCoverMap::~CropCoverMap() = default;
@@ -228,16 +301,29 @@ void CropCoverMap::rasterise(Tile& tile, std::int64_t tile_east, std::int64_t ti
                     const double by = base.north_m - north0;
                     const double tx = bx + length * std::cos(azimuth);
                     const double ty = by + length * std::sin(azimuth);
-                    const int i_first = std::max(0, static_cast<int>(std::floor((std::min(bx, tx) - half_width) / kCellM)));
-                    const int i_last = std::min(kTileCells - 1, static_cast<int>(std::floor((std::max(bx, tx) + half_width) / kCellM)));
+                    if (std::max(bx, tx) + half_width < 0.0 || std::min(bx, tx) - half_width > kTileM) continue;  // beside the tile
+                    const Capsule leaf_shape(bx, by, tx, ty);
                     const int j_first = std::max(0, static_cast<int>(std::floor((std::min(by, ty) - half_width) / kCellM)));
                     const int j_last = std::min(kTileCells - 1, static_cast<int>(std::floor((std::max(by, ty) + half_width) / kCellM)));
                     for (int j = j_first; j <= j_last; ++j) {
                         const double cy = (j + 0.5) * kCellM;
+                        // A cell is plant when its centre is within half_width of
+                        // the leaf's mid-line. Centres within the slice narrowed by
+                        // kSureM are surely so and centres outside the one widened
+                        // by it surely not (rounding is some 1e-18 m here); only
+                        // those between take the exact test.
+                        const Span maybe = leaf_shape.slice(cy, half_width + kSureM);
+                        if (maybe.low > maybe.high || maybe.high < 0.0 || maybe.low > kTileM) continue;
+                        const Span sure = leaf_shape.slice(cy, half_width - kSureM);
+                        const int i_first = std::max(0, static_cast<int>(std::floor(maybe.low / kCellM - 0.5)));
+                        const int i_last = std::min(kTileCells - 1, static_cast<int>(std::ceil(maybe.high / kCellM - 0.5)));
+                        std::uint8_t* tile_row = tile.plant.data() + static_cast<std::size_t>(j) * kTileCells;
                         for (int i = i_first; i <= i_last; ++i) {
                             const double cx = (i + 0.5) * kCellM;
-                            if (segment_distance_sq(cx, cy, bx, by, tx, ty) <= half_width * half_width) {
-                                tile.plant[static_cast<std::size_t>(j) * kTileCells + static_cast<std::size_t>(i)] = 1;
+                            if (cx > sure.low && cx < sure.high) {
+                                tile_row[i] = kPlantCell;
+                            } else if (segment_distance_sq(cx, cy, bx, by, tx, ty) <= half_width * half_width) {
+                                tile_row[i] = kPlantCell;
                             }
                         }
                     }
@@ -282,6 +368,35 @@ double CropCoverMap::cover_fraction(const std::array<Vec2, 4>& corners) const {
     }
     if (inside == 0) throw std::invalid_argument("crop cover_fraction: the quadrilateral holds no 1 mm cell centre");
     return static_cast<double>(plant) / static_cast<double>(inside);
+}
+
+void CropCoverMap::copy_cells(std::int64_t east_cell, std::int64_t north_cell, int cols, int rows, std::uint8_t* out,
+                              std::size_t stride) const {
+    const auto far = [](std::int64_t first, int count) {
+        return first <= -kMaxCellIndex || first + count >= kMaxCellIndex;
+    };
+    if (cols <= 0 || rows <= 0 || far(east_cell, cols) || far(north_cell, rows)) {
+        throw std::invalid_argument("crop copy_cells: " + std::to_string(cols) + " x " + std::to_string(rows) + " cells from (" +
+                                    std::to_string(east_cell) + ", " + std::to_string(north_cell) +
+                                    ") mm is empty or reaches 1000 km or more from the origin");
+    }
+    const std::int64_t east_end = east_cell + cols;
+    const std::int64_t north_end = north_cell + rows;
+    for (std::int64_t tile_north = north_cell >> kTileShift; tile_north * kTileCells < north_end; ++tile_north) {
+        const std::int64_t j_first = std::max(north_cell, tile_north * kTileCells);
+        const std::int64_t j_end = std::min(north_end, (tile_north + 1) * kTileCells);
+        for (std::int64_t tile_east = east_cell >> kTileShift; tile_east * kTileCells < east_end; ++tile_east) {
+            const std::int64_t i_first = std::max(east_cell, tile_east * kTileCells);
+            const std::int64_t i_end = std::min(east_end, (tile_east + 1) * kTileCells);
+            const Tile& t = tile(tile_east, tile_north);
+            for (std::int64_t j = j_first; j < j_end; ++j) {
+                const std::uint8_t* from = t.plant.data() + static_cast<std::size_t>(j - tile_north * kTileCells) * kTileCells +
+                                           static_cast<std::size_t>(i_first - tile_east * kTileCells);
+                std::uint8_t* to = out + static_cast<std::size_t>(j - north_cell) * stride + static_cast<std::size_t>(i_first - east_cell);
+                std::memcpy(to, from, static_cast<std::size_t>(i_end - i_first));
+            }
+        }
+    }
 }
 
 std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m, double width_m,

@@ -14,8 +14,9 @@
 // each are polygons laid over a default class.
 //
 // Truth is a raster of 1 mm cells: a cell is plant when its centre lies on a
-// leaf. is_plant() reads that raster and cover_fraction() counts its cells, so
-// the two agree exactly; 1 mm is an eighth of a leaf's width and a third of a
+// leaf. is_plant() reads that raster, cover_fraction() counts its cells and
+// copy_cells() hands a block of it to the camera renderer, so all three agree
+// exactly; 1 mm is an eighth of a leaf's width and a third of a
 // camera pixel's footprint on the ground (about 2.5 mm at 1280 x 720 from
 // 1.5 m), fine enough to be ground truth for both.
 //
@@ -24,6 +25,7 @@
 // needs no storage up front; the raster is built in tiles on first use and
 // cached (the class is therefore not safe to share between threads).
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -79,6 +81,9 @@ class CropCoverMap {
 public:
     // The truth raster's cell size.
     static constexpr double kCellM = 0.001;
+    // A plant cell's value in copy_cells() (soil is 0): full scale of an
+    // 8-bit cover image, so a bilinear sample of it reads as cover x 255.
+    static constexpr std::uint8_t kPlantCell = 255;
 
     // Throws std::invalid_argument as validate() does.
     CropCoverMap(CropCoverParams params, std::uint64_t seed);
@@ -96,10 +101,21 @@ public:
     // that are plant. Throws std::invalid_argument for a non-finite corner,
     // edges that cross, or a quadrilateral holding no cell centre.
     double cover_fraction(const std::array<Vec2, 4>& corners) const;
+    // The block of cells east_cell .. east_cell + cols - 1 by north_cell ..
+    // north_cell + rows - 1 (cell (i, j) is the ground from i to i + 1 mm east
+    // and j to j + 1 mm north) into `out`, row r (the cells north_cell + r)
+    // starting at out + r * stride: kPlantCell where plant, 0 where soil.
+    // Throws std::invalid_argument for an empty block or one reaching 1000 km
+    // or more from the origin.
+    void copy_cells(std::int64_t east_cell, std::int64_t north_cell, int cols, int rows, std::uint8_t* out,
+                    std::size_t stride) const;
 
     const CropCoverParams& params() const { return params_; }
     std::uint64_t seed() const { return seed_; }
     std::size_t cached_tile_count() const { return tiles_.size(); }
+    // A number no other map built in this process has (a move hands it on):
+    // a renderer keeps a copy of some cells and must know whose they are.
+    std::uint64_t identity() const { return identity_; }
 
 private:
     struct Tile;
@@ -108,6 +124,7 @@ private:
 
     CropCoverParams params_;
     std::uint64_t seed_;
+    std::uint64_t identity_;
     mutable std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
     mutable const Tile* last_tile_ = nullptr;
     mutable std::uint64_t last_key_ = 0;

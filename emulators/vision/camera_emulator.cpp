@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "emulators/field2d/counter_hash.h"
 #include "rig/camera/parameter_check.h"
@@ -17,7 +21,36 @@ using rig::camera::require_parameter;
 
 using rig::camera::Rgb;
 using rig::camera::RgbImage;
+using rig::field2d::CropCoverMap;
 using rig::field2d::Vec2;
+
+// render()'s cover window: at most 24 M cells (24 MB, 4.9 x 4.9 m of ground)
+// and 8000 cells a side (the fixed-point maps hold coordinates in 16 bits);
+// the seed-001 view is about 3.2 x 1.7 m. A margin of 0.5 m all round lets a
+// boom at 1.5 m/s keep one window for several frames (30 cm a frame at 5 fps).
+constexpr std::int64_t kMaxWindowCells = 24'000'000;
+constexpr std::int64_t kMaxWindowSide = 8'000;
+constexpr std::int64_t kWindowMarginCells = 500;
+// A map coordinate that sees no ground is clamped here (relative to the boom
+// centre's cell), so it stays a finite 16-bit number after the window's offset.
+constexpr float kFarCells = 16'000.0F;
+// Rows of samples render() works through at a time: 2^16 samples, a band that
+// stays in cache and that OpenCV does on the calling thread (it splits a call
+// into stripes of 2^16 pixels; one stripe runs where it was called).
+constexpr int kBandSamples = 1 << 16;
+// Noise: a frame's window into the table starts at one of 256 x 256 shifts.
+constexpr int kNoiseShifts = 256;
+// Colour and noise are summed in 1/64 DN and rounded once, as a sensor's ADC
+// sees light plus noise: rounding the lit colour on its own first would shift
+// a colour by up to half a DN everywhere (the low-sun leaf's ExG of 42 sits
+// at the controller's floor of 40, where that shows).
+constexpr double kSubDn = 64.0;
+
+// A lit colour in 1/64 DN. Above 511 DN (the most 16 bits hold) it is held
+// at 511: noise (at most 3.47 x 50 DN) cannot bring it below 255 there, so
+// the frame still reads 255, as it would unheld; and the sum saturates at
+// 32767 (511.98 DN), which reads 255 too.
+std::int16_t sub_dn(double dn) { return static_cast<std::int16_t>(std::lround(std::clamp(dn, 0.0, 511.0) * kSubDn)); }
 
 void require_gains(const ChannelGains& gains, const std::string& where, const char* which) {
     const std::string prefix = where + "." + which;
@@ -47,6 +80,33 @@ std::uint8_t to_byte(double value) {
     if (!(value > 0.0)) return 0;
     if (value >= 255.0) return 255;
     return static_cast<std::uint8_t>(value + 0.5);
+}
+
+void require_boom_height(const std::string& name, const BoomPose& pose) {
+    if (finite_within(pose.boom_height_m, 1e-9, 5.0)) return;
+    std::ostringstream message;
+    message << name << ": boom height " << pose.boom_height_m << " m is outside (0, 5] m";
+    throw std::invalid_argument(message.str());
+}
+
+// What a dead camera delivers: nothing, or a black frame.
+std::optional<RgbImage> dead_camera_frame(DeadCamera dead, int width, int height) {
+    if (dead == DeadCamera::no_frame) return std::nullopt;
+    return RgbImage(width, height);
+}
+
+// The scene's colours as the camera sees them under the light and cast.
+struct LitColours {
+    double red_gain;
+    double green_gain;
+    double blue_gain;
+};
+
+LitColours lit_colours(const CameraEmulatorParams& params) {
+    const double gain = params.lighting_gain;
+    return LitColours{gain * params.lighting_cast.red * params.faults.colour_cast.red,
+                      gain * params.lighting_cast.green * params.faults.colour_cast.green,
+                      gain * params.lighting_cast.blue * params.faults.colour_cast.blue};
 }
 
 }  // namespace
@@ -94,6 +154,118 @@ CameraEmulator::CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, 
             corner_ray_valid_[i] = 1;
         }
     }
+
+    // render()'s fixed part. The boom frame is level, so which corner rays
+    // meet the ground depends on the mounting alone, not on the pose.
+    const Eigen::Matrix3d& axes = camera_.axes_in_boom();
+    corner_x_.assign(corner_rays_.size(), 0.0F);
+    corner_y_.assign(corner_rays_.size(), 0.0F);
+    std::vector<std::uint8_t> corner_hits(corner_rays_.size(), 0);
+    for (std::size_t i = 0; i < corner_rays_.size(); ++i) {
+        if (corner_ray_valid_[i] == 0) continue;
+        const double down = axes.row(2).dot(Eigen::Vector3d(corner_rays_[i].x(), corner_rays_[i].y(), 1.0));
+        if (down >= -1e-9) continue;  // at or above the horizon, as render_scene() has it
+        corner_x_[i] = static_cast<float>(corner_rays_[i].x());
+        corner_y_[i] = static_cast<float>(corner_rays_[i].y());
+        corner_hits[i] = 1;
+    }
+    const std::size_t stride = static_cast<std::size_t>(width) + 1U;
+    if (params_.samples_per_axis == 1) {
+        // One sample a pixel, at its centre (the mean of its corners, as n x n has it).
+        centre_x_.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+        centre_y_.resize(centre_x_.size());
+        for (int v = 0; v < height; ++v) {
+            for (int u = 0; u < width; ++u) {
+                const std::size_t i00 = static_cast<std::size_t>(v) * stride + static_cast<std::size_t>(u);
+                const std::size_t pixel = static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u);
+                const float top_x = corner_x_[i00] + 0.5F * (corner_x_[i00 + 1] - corner_x_[i00]);
+                const float bottom_x = corner_x_[i00 + stride] + 0.5F * (corner_x_[i00 + stride + 1] - corner_x_[i00 + stride]);
+                const float top_y = corner_y_[i00] + 0.5F * (corner_y_[i00 + 1] - corner_y_[i00]);
+                const float bottom_y = corner_y_[i00 + stride] + 0.5F * (corner_y_[i00 + stride + 1] - corner_y_[i00 + stride]);
+                centre_x_[pixel] = top_x + 0.5F * (bottom_x - top_x);
+                centre_y_[pixel] = top_y + 0.5F * (bottom_y - top_y);
+            }
+        }
+    }
+    sky_pixels_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0);
+    for (int v = 0; v < height; ++v) {
+        for (int u = 0; u < width; ++u) {
+            const std::size_t i00 = static_cast<std::size_t>(v) * stride + static_cast<std::size_t>(u);
+            if (corner_hits[i00] && corner_hits[i00 + 1] && corner_hits[i00 + stride] && corner_hits[i00 + stride + 1]) continue;
+            sky_pixels_[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)] = 255;
+            any_sky_ = true;
+        }
+    }
+    auto sees_ground = [&](int u, int v) {
+        return u >= 0 && v >= 0 && u < width && v < height &&
+               sky_pixels_[static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u)] == 0;
+    };
+    for (int v = 0; v <= height; ++v) {
+        for (int u = 0; u <= width; ++u) {
+            const int touching_ground = sees_ground(u - 1, v - 1) + sees_ground(u, v - 1) + sees_ground(u - 1, v) + sees_ground(u, v);
+            if (touching_ground > 0 && touching_ground < 4) {
+                outline_corners_.push_back(static_cast<std::size_t>(v) * stride + static_cast<std::size_t>(u));
+            }
+        }
+    }
+
+    if (params_.noise_sd_dn > 0.0) {
+        const std::size_t table_values =
+            3U * static_cast<std::size_t>(width + kNoiseShifts - 1) * static_cast<std::size_t>(height + kNoiseShifts - 1);
+        noise_.resize(table_values);
+        const std::uint64_t table_key = rig::field2d::hash_finalise(noise_key_ ^ 0x7ab1e000ULL);
+        for (std::size_t i = 0; i < table_values; ++i) {
+            const double draw = params_.noise_sd_dn * unit_noise(rig::field2d::hash_finalise(table_key + i));
+            noise_[i] = static_cast<std::int16_t>(std::lround(draw * kSubDn));
+        }
+    }
+}
+
+Eigen::Matrix3d CameraEmulator::normalized_to_ground_cells(const BoomPose& pose, double east_origin, double north_origin) const {
+    // A ray d = axes (x, y, 1) from the camera at p meets the ground z = -h at
+    // p + (drop / d_z) d, drop = -h - p_z: in the boom frame, homogeneously,
+    // (p_x d_z + drop d_x, p_y d_z + drop d_y, d_z), linear in (x, y, 1).
+    const Eigen::Matrix3d& axes = camera_.axes_in_boom();
+    const Eigen::Vector3d& position = camera_.position_in_boom();
+    const double drop = -pose.boom_height_m - position.z();
+    Eigen::Matrix3d boom_ground;
+    boom_ground.row(0) = drop * axes.row(0) + position.x() * axes.row(2);
+    boom_ground.row(1) = drop * axes.row(1) + position.y() * axes.row(2);
+    boom_ground.row(2) = axes.row(2);
+    // Boom frame to the truth's cells (field2d::body_to_field, over kCellM,
+    // less half a cell: cell i's centre sits at i).
+    const Vec2 right = rig::field2d::right_of(pose.heading_deg);
+    const Vec2 forward = rig::field2d::forward_of(pose.heading_deg);
+    const double per_cell = 1.0 / CropCoverMap::kCellM;
+    Eigen::Matrix3d to_cells;
+    to_cells << right.east_m * per_cell, forward.east_m * per_cell, pose.boom_centre_ground.east_m * per_cell - 0.5 - east_origin,
+        right.north_m * per_cell, forward.north_m * per_cell, pose.boom_centre_ground.north_m * per_cell - 0.5 - north_origin,
+        0.0, 0.0, 1.0;
+    return to_cells * boom_ground;
+}
+
+void CameraEmulator::hold_cells(const CropCoverMap& crop, std::int64_t east_first, std::int64_t east_last, std::int64_t north_first,
+                                std::int64_t north_last) const {
+    CoverWindow& w = window_;
+    if (w.crop_identity == crop.identity() && east_first >= w.east_cell && north_first >= w.north_cell &&
+        east_last < w.east_cell + w.cols && north_last < w.north_cell + w.rows) {
+        return;
+    }
+    const std::int64_t cols = east_last - east_first + 1;
+    const std::int64_t rows = north_last - north_first + 1;
+    std::int64_t margin = kWindowMarginCells;
+    while (margin > 0 && ((cols + 2 * margin) * (rows + 2 * margin) > kMaxWindowCells || cols + 2 * margin > kMaxWindowSide ||
+                          rows + 2 * margin > kMaxWindowSide)) {
+        margin /= 2;
+    }
+    w.crop_identity = 0;  // holds nothing until the copy below has finished
+    w.east_cell = east_first - margin;
+    w.north_cell = north_first - margin;
+    w.cols = static_cast<int>(cols + 2 * margin);
+    w.rows = static_cast<int>(rows + 2 * margin);
+    w.cells.resize(static_cast<std::size_t>(w.cols) * static_cast<std::size_t>(w.rows));
+    crop.copy_cells(w.east_cell, w.north_cell, w.cols, w.rows, w.cells.data(), static_cast<std::size_t>(w.cols));
+    w.crop_identity = crop.identity();
 }
 
 std::optional<Vec2> CameraEmulator::ground_seen(const BoomPose& pose, double u, double v) const {
@@ -102,11 +274,175 @@ std::optional<Vec2> CameraEmulator::ground_seen(const BoomPose& pose, double u, 
     return rig::field2d::body_to_field(pose.boom_centre_ground, pose.heading_deg, boom_xy->x(), boom_xy->y());
 }
 
-std::optional<RgbImage> CameraEmulator::render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
-                                               std::uint64_t frame_index) const {
-    return render_scene(crop, pose, nullptr, nullptr, frame_index);
-}
+std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const BoomPose& pose, std::uint64_t frame_index) const {
+    require_boom_height(name_, pose);
+    if (!(std::abs(pose.boom_centre_ground.east_m) < 1e6 && std::abs(pose.boom_centre_ground.north_m) < 1e6)) {
+        std::ostringstream message;
+        message << name_ << ": boom centre (" << pose.boom_centre_ground.east_m << ", " << pose.boom_centre_ground.north_m
+                << ") m is not a ground point within 1000 km of the origin";
+        throw std::invalid_argument(message.str());
+    }
+    const CameraFaults& faults = params_.faults;
+    const int width = camera_.width_px();
+    const int height = camera_.height_px();
+    if (faults.dead != DeadCamera::none) return dead_camera_frame(faults.dead, width, height);
+    RgbImage image(width, height);
 
+    // The view's extent in cells, from its outline: a homography maps the
+    // inside of a closed curve inside the curve's image (all corners on the
+    // ground side of the horizon), and a sample is a convex mix of its
+    // pixel's corners. Around the boom centre's cell first, for small numbers.
+    const double per_cell = 1.0 / CropCoverMap::kCellM;
+    const double centre_east = std::floor(pose.boom_centre_ground.east_m * per_cell);
+    const double centre_north = std::floor(pose.boom_centre_ground.north_m * per_cell);
+    const Eigen::Matrix3d around_centre = normalized_to_ground_cells(pose, centre_east, centre_north);
+    double east_min = std::numeric_limits<double>::infinity();
+    double east_max = -east_min;
+    double north_min = east_min;
+    double north_max = -east_min;
+    for (const std::size_t i : outline_corners_) {
+        const Eigen::Vector3d p = around_centre * Eigen::Vector3d(corner_x_[i], corner_y_[i], 1.0);
+        east_min = std::min(east_min, p.x() / p.z());
+        east_max = std::max(east_max, p.x() / p.z());
+        north_min = std::min(north_min, p.y() / p.z());
+        north_max = std::max(north_max, p.y() / p.z());
+    }
+    const bool sees_ground = !outline_corners_.empty();
+    // The cells a bilinear sample may read (its cell and the next, and a cell
+    // more each way for single-precision rounding of the samples' positions).
+    double view_east = 0.0;
+    double view_north = 0.0;
+    if (sees_ground) {
+        const double cols = std::floor(east_max) - std::floor(east_min) + 4.0;
+        const double rows = std::floor(north_max) - std::floor(north_min) + 4.0;
+        if (!(cols <= static_cast<double>(kMaxWindowSide) && rows <= static_cast<double>(kMaxWindowSide) &&
+              cols * rows <= static_cast<double>(kMaxWindowCells))) {
+            return render_scene(crop, pose, nullptr, nullptr, frame_index);  // a view reaching far: the exact path
+        }
+        view_east = centre_east + std::floor(east_min) - 1.0;
+        view_north = centre_north + std::floor(north_min) - 1.0;
+        hold_cells(crop, static_cast<std::int64_t>(view_east), static_cast<std::int64_t>(view_east + cols - 1.0),
+                   static_cast<std::int64_t>(view_north), static_cast<std::int64_t>(view_north + rows - 1.0));
+    }
+    // The maps count from the view's first cell, a function of the pose alone:
+    // a frame's bytes do not depend on where the window happens to lie.
+    const Eigen::Matrix3d to_view = normalized_to_ground_cells(pose, view_east, view_north);
+    const Eigen::Matrix3f h = to_view.cast<float>();
+
+    // Colour by cover (0 soil .. 255 plant) under this camera's light.
+    const LitColours light = lit_colours(params_);
+    cv::Mat cover_to_rgb(1, 256, CV_16SC3);
+    for (int cover = 0; cover < 256; ++cover) {
+        const double plant_share = cover / 255.0;
+        const Rgb soil = params_.soil_rgb;
+        const Rgb plant = params_.plant_rgb;
+        cover_to_rgb.at<cv::Vec3s>(0, cover) =
+            cv::Vec3s(sub_dn((soil.r + plant_share * (plant.r - soil.r)) * light.red_gain),
+                      sub_dn((soil.g + plant_share * (plant.g - soil.g)) * light.green_gain),
+                      sub_dn((soil.b + plant_share * (plant.b - soil.b)) * light.blue_gain));
+    }
+    const cv::Scalar sky(sub_dn(params_.sky_rgb.r * light.red_gain), sub_dn(params_.sky_rgb.g * light.green_gain),
+                         sub_dn(params_.sky_rgb.b * light.blue_gain));
+
+    // This frame's window into the noise table.
+    const std::uint64_t frame_key = rig::field2d::hash_finalise(noise_key_ ^ rig::field2d::hash_finalise(frame_index));
+    const int noise_u = static_cast<int>(frame_key % kNoiseShifts);
+    const int noise_v = static_cast<int>((frame_key >> 32) % kNoiseShifts);
+    // Headers over this object's own tables, only read (OpenCV has no const Mat over const data).
+    const int table_width = width + kNoiseShifts - 1;
+    const int table_height = height + kNoiseShifts - 1;
+    cv::Mat noise;
+    if (!noise_.empty()) noise = cv::Mat(table_height, table_width, CV_16SC3, const_cast<std::int16_t*>(noise_.data()));
+    const cv::Mat sky_pixels(height, width, CV_8UC1, const_cast<std::uint8_t*>(sky_pixels_.data()));
+    // The maps count from the view's first cell: remap reads the window from there.
+    cv::Mat view;
+    if (sees_ground) {
+        const cv::Mat window(window_.rows, window_.cols, CV_8UC1, window_.cells.data());
+        view = window(cv::Rect(static_cast<int>(static_cast<std::int64_t>(view_east) - window_.east_cell),
+                               static_cast<int>(static_cast<std::int64_t>(view_north) - window_.north_cell),
+                               static_cast<int>(window_.east_cell + window_.cols - static_cast<std::int64_t>(view_east)),
+                               static_cast<int>(window_.north_cell + window_.rows - static_cast<std::int64_t>(view_north))));
+    }
+    const cv::Mat frame(height, width, CV_8UC3, image.bytes.data());
+
+    const int n = params_.samples_per_axis;
+    const int band_rows = std::max(1, kBandSamples / (width * n * n));
+    const std::size_t stride = static_cast<std::size_t>(width) + 1U;
+    cv::Mat map_x(band_rows * n, width * n, CV_32FC1);
+    cv::Mat map_y(band_rows * n, width * n, CV_32FC1);
+    cv::Mat fixed_xy;
+    cv::Mat samples;
+    cv::Mat cover;
+    cv::Mat cover_rgb;
+    cv::Mat lit;
+    Eigen::ArrayXf row_x(width + 1);
+    Eigen::ArrayXf row_y(width + 1);
+    Eigen::ArrayXf sample_x(width);
+    Eigen::ArrayXf sample_y(width);
+    Eigen::ArrayXf depth(width);
+    Eigen::ArrayXf seen_x(width);
+    Eigen::ArrayXf seen_y(width);
+    using Row = Eigen::Map<const Eigen::ArrayXf>;
+    using Strided = Eigen::Map<Eigen::ArrayXf, 0, Eigen::InnerStride<>>;
+    for (int v0 = 0; v0 < height; v0 += band_rows) {
+        const int rows = std::min(band_rows, height - v0);
+        if (sees_ground) {
+            const int sample_rows = rows * n;
+            for (int sample_row = 0; sample_row < sample_rows; ++sample_row) {
+                const auto v = static_cast<std::size_t>(v0 + sample_row / n);
+                if (n == 1) {
+                    const Row centre_x(centre_x_.data() + v * static_cast<std::size_t>(width), width);
+                    const Row centre_y(centre_y_.data() + v * static_cast<std::size_t>(width), width);
+                    depth = (h(2, 0) * centre_x + h(2, 1) * centre_y + h(2, 2)).min(-1e-6F);
+                    Eigen::Map<Eigen::ArrayXf>(map_x.ptr<float>(sample_row), width) =
+                        ((h(0, 0) * centre_x + h(0, 1) * centre_y + h(0, 2)) / depth).max(-kFarCells).min(kFarCells);
+                    Eigen::Map<Eigen::ArrayXf>(map_y.ptr<float>(sample_row), width) =
+                        ((h(1, 0) * centre_x + h(1, 1) * centre_y + h(1, 2)) / depth).max(-kFarCells).min(kFarCells);
+                    continue;
+                }
+                const float down = (static_cast<float>(sample_row % n) + 0.5F) / static_cast<float>(n);
+                const Row top_x(corner_x_.data() + v * stride, width + 1);
+                const Row top_y(corner_y_.data() + v * stride, width + 1);
+                const Row bottom_x(corner_x_.data() + (v + 1) * stride, width + 1);
+                const Row bottom_y(corner_y_.data() + (v + 1) * stride, width + 1);
+                row_x = top_x + down * (bottom_x - top_x);
+                row_y = top_y + down * (bottom_y - top_y);
+                for (int sample_col = 0; sample_col < n; ++sample_col) {
+                    const float across = (static_cast<float>(sample_col) + 0.5F) / static_cast<float>(n);
+                    sample_x = row_x.head(width) + across * (row_x.tail(width) - row_x.head(width));
+                    sample_y = row_y.head(width) + across * (row_y.tail(width) - row_y.head(width));
+                    // Below the horizon the depth is negative; a sky pixel's
+                    // samples are pushed far off the window (it is painted sky below).
+                    depth = (h(2, 0) * sample_x + h(2, 1) * sample_y + h(2, 2)).min(-1e-6F);
+                    seen_x = ((h(0, 0) * sample_x + h(0, 1) * sample_y + h(0, 2)) / depth).max(-kFarCells).min(kFarCells);
+                    seen_y = ((h(1, 0) * sample_x + h(1, 1) * sample_y + h(1, 2)) / depth).max(-kFarCells).min(kFarCells);
+                    Strided(map_x.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_x;
+                    Strided(map_y.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_y;
+                }
+            }
+            // Each sample reads the truth cell it falls in (the nearest cell
+            // centre), as render_scene's samples do: a pixel's mix at a leaf
+            // edge comes from its n x n samples, not from blurring the truth.
+            cv::convertMaps(map_x.rowRange(0, sample_rows), map_y.rowRange(0, sample_rows), fixed_xy, cv::noArray(), CV_16SC2, true);
+            cv::remap(view, samples, fixed_xy, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+            if (n > 1) {
+                cv::resize(samples, cover, cv::Size(width, rows), 0.0, 0.0, cv::INTER_AREA);  // the mean of n x n
+            } else {
+                cover = samples;
+            }
+        } else {
+            cover = cv::Mat::zeros(rows, width, CV_8UC1);
+        }
+        cv::cvtColor(cover, cover_rgb, cv::COLOR_GRAY2RGB);
+        cv::LUT(cover_rgb, cover_to_rgb, lit);
+        if (any_sky_) lit.setTo(sky, sky_pixels.rowRange(v0, v0 + rows));
+        if (!noise_.empty()) cv::add(lit, noise(cv::Rect(noise_u, noise_v + v0, width, rows)), lit);
+        cv::Mat band = frame.rowRange(v0, v0 + rows);
+        lit.convertTo(band, CV_8U, 1.0 / kSubDn);  // rounded (exact in binary: a power of two) and clipped to 0-255
+    }
+    if (faults.blur_radius_px > 0) box_blur(image, faults.blur_radius_px);
+    return image;
+}
 namespace {
 
 // The board (if any) at a boom-plane point, as its colour.
@@ -165,17 +501,12 @@ std::optional<RgbImage> CameraEmulator::render_chessboard(const rig::field2d::Cr
 std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                      const PlaneOverlay* boom_plane, const PlaneOverlay* ground,
                                                      std::uint64_t frame_index) const {
-    if (!finite_within(pose.boom_height_m, 1e-9, 5.0)) {
-        std::ostringstream message;
-        message << name_ << ": boom height " << pose.boom_height_m << " m is outside (0, 5] m";
-        throw std::invalid_argument(message.str());
-    }
+    require_boom_height(name_, pose);
     const CameraFaults& faults = params_.faults;
-    if (faults.dead == DeadCamera::no_frame) return std::nullopt;
     const int width = camera_.width_px();
     const int height = camera_.height_px();
+    if (faults.dead != DeadCamera::none) return dead_camera_frame(faults.dead, width, height);
     RgbImage image(width, height);
-    if (faults.dead == DeadCamera::black_frame) return image;
 
     // Each corner ray met with the ground (z = -h in the boom frame), as
     // east/north offsets from the boom centre's ground point (and, for a
@@ -206,10 +537,10 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
         corner_hits[i] = 1;
     }
 
-    const double gain = params_.lighting_gain;
-    const double red_gain = gain * params_.lighting_cast.red * faults.colour_cast.red;
-    const double green_gain = gain * params_.lighting_cast.green * faults.colour_cast.green;
-    const double blue_gain = gain * params_.lighting_cast.blue * faults.colour_cast.blue;
+    const LitColours light = lit_colours(params_);
+    const double red_gain = light.red_gain;
+    const double green_gain = light.green_gain;
+    const double blue_gain = light.blue_gain;
     const Rgb soil = params_.soil_rgb;
     const Rgb plant = params_.plant_rgb;
     const Rgb sky = params_.sky_rgb;
@@ -284,30 +615,11 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
 
 void box_blur(RgbImage& image, int radius_px) {
     if (radius_px <= 0 || image.width <= 0 || image.height <= 0) return;
-    const int width = image.width;
-    const int height = image.height;
     const int window = 2 * radius_px + 1;
-    std::vector<std::uint8_t> source = image.bytes;
-    // One pass along a line of `count` pixels `step` bytes apart, from `from` into `to`.
-    auto blur_line = [&](const std::vector<std::uint8_t>& from, std::vector<std::uint8_t>& to, std::size_t start,
-                         std::size_t step, int count) {
-        for (int channel = 0; channel < 3; ++channel) {
-            auto value_at = [&](int index) {
-                const int clamped = std::clamp(index, 0, count - 1);
-                return static_cast<int>(from[start + static_cast<std::size_t>(clamped) * step + static_cast<std::size_t>(channel)]);
-            };
-            int sum = 0;
-            for (int k = -radius_px; k <= radius_px; ++k) sum += value_at(k);
-            for (int index = 0; index < count; ++index) {
-                to[start + static_cast<std::size_t>(index) * step + static_cast<std::size_t>(channel)] =
-                    static_cast<std::uint8_t>((sum + window / 2) / window);
-                sum += value_at(index + radius_px + 1) - value_at(index - radius_px);
-            }
-        }
-    };
-    std::vector<std::uint8_t> across(source.size());
-    for (int v = 0; v < height; ++v) blur_line(source, across, image.offset(0, v), 3U, width);
-    for (int u = 0; u < width; ++u) blur_line(across, image.bytes, image.offset(u, 0), static_cast<std::size_t>(width) * 3U, height);
+    const cv::Mat source(image.height, image.width, CV_8UC3, image.bytes.data());
+    cv::Mat blurred;
+    cv::blur(source, blurred, cv::Size(window, window), cv::Point(-1, -1), cv::BORDER_REPLICATE);
+    std::copy(blurred.datastart, blurred.dataend, image.bytes.begin());
 }
 
 }  // namespace rig::emulators::vision

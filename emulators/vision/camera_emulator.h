@@ -6,12 +6,30 @@
 // lens distortion and mounting (rig/camera/pinhole_camera.h) at the live boom
 // height. No DDS: a plain class the harness or a test drives.
 //
-// Each pixel's colour is the soil / plant mix of its footprint (n x n samples
-// of the crop truth inside the pixel), times the lighting and colour cast,
-// plus seeded noise per channel, clipped to 0-255. The boom and nozzles are
-// not drawn: they sit below the ROIs in the image (the nozzles at row ~665,
-// Eq. 1-4's ~661, against the ROIs' rows 355-575 with the defaults) and nothing
+// A pixel's colour is the soil / plant mix of its footprint (n x n samples of
+// the crop truth inside the pixel), times the lighting and colour cast, plus
+// seeded noise per channel, clipped to 0-255. The boom and nozzles are not
+// drawn: they sit below the ROIs in the image (the nozzles at row ~665, Eq.
+// 1-4's ~661, against the ROIs' rows 355-575 with the defaults) and nothing
 // measures them in a working frame; render_calibration() draws Sec. 2.2.1's boards.
+//
+// How render() does it (docs/seed001-vision.md, "Rendering"): the ground is a
+// plane, so a sample's undistorted image point maps to the ground by a
+// homography that the live boom pose sets; the lens distortion is fixed, its
+// inverse computed once per camera at the pixel corners. Per frame the two
+// compose into a per-sample map into a cover image (a block of the crop
+// truth's 1 mm raster, plant 255, soil 0, kept while the view stays inside
+// it), sampled bilinearly by OpenCV's fixed-point remap: a leaf edge inside a
+// sample gives a mixed value, as a pixel straddling it would. n x n samples
+// average to the pixel (area resize). Colour is a per-frame table from cover
+// to RGB; the noise a shifted window of a seeded per-camera table (a frame's
+// shift hashed from its index). All of it is integer arithmetic on maps fixed
+// to 1/32 px, so a frame's bytes are a function of the case, seed, pose and
+// frame index alone, whatever the machine or the order frames are rendered in.
+// Views reaching far (the window would exceed 24 M cells, e.g. a camera pitched
+// near the horizon) and the calibration scenes (boards, chessboards: a few
+// frames a run) take the exact per-sample path instead: corner rays through
+// the planes, each sample a look-up of the truth.
 //
 // Named faults, ArduPilot SITL style (each off at its default):
 //   pitch_offset_deg  the camera knocked off the pitch it was calibrated at
@@ -122,7 +140,9 @@ public:
 
     // The frame number `frame_index` (its noise is drawn from it) of the
     // ground at `pose`; nullopt for a dead camera that delivers no frame.
-    // Throws std::invalid_argument for a bad boom height.
+    // Throws std::invalid_argument for a bad boom height or a view reaching
+    // 1000 km from the crop's origin. Keeps a block of the crop's cells between
+    // calls: not safe to call from two threads at once.
     std::optional<rig::camera::RgbImage> render(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
                                                 std::uint64_t frame_index) const;
 
@@ -146,6 +166,14 @@ public:
     const std::string& name() const { return name_; }
 
 private:
+    // The homography from undistorted normalised image points (x, y, 1) to the
+    // ground at `pose`, in the crop truth's cells (cell i's centre at i) less
+    // (east_origin, north_origin).
+    Eigen::Matrix3d normalized_to_ground_cells(const BoomPose& pose, double east_origin, double north_origin) const;
+    // Refills window_ (with a margin) unless it holds cells [east_first,
+    // east_last] x [north_first, north_last] of `crop` already.
+    void hold_cells(const rig::field2d::CropCoverMap& crop, std::int64_t east_first, std::int64_t east_last,
+                    std::int64_t north_first, std::int64_t north_last) const;
     // What lies on a plane at boom-frame (x, y): a board's colour, or nothing.
     using PlaneOverlay = std::function<std::optional<rig::camera::Rgb>(double x_m, double y_m)>;
     std::optional<rig::camera::RgbImage> render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
@@ -159,14 +187,40 @@ private:
     // a pixel's footprint is the ground between its four corners' rays.
     std::vector<Eigen::Vector2d> corner_rays_;
     std::vector<std::uint8_t> corner_ray_valid_;
+    // The same rays for render() in single precision, split by axis (zero
+    // where a pixel sees no ground); the pixels whose four corner rays do not
+    // all meet the ground (255: sky) and whether there are any; the corners on
+    // the outline of the pixels that see ground (the view's extremes lie on it).
+    std::vector<float> corner_x_;
+    std::vector<float> corner_y_;
+    // With one sample a pixel, its centre's undistorted point (else empty).
+    std::vector<float> centre_x_;
+    std::vector<float> centre_y_;
+    std::vector<std::uint8_t> sky_pixels_;
+    bool any_sky_ = false;
+    std::vector<std::size_t> outline_corners_;
+    // The noise table: N(0, noise_sd_dn) draws per channel in 1/64 DN,
+    // (width + kNoiseShifts - 1) x (height + kNoiseShifts - 1) pixels; empty
+    // without noise.
+    std::vector<std::int16_t> noise_;
+    // The block of the crop's truth render() samples.
+    struct CoverWindow {
+        std::uint64_t crop_identity = 0;  // 0: holds nothing
+        std::int64_t east_cell = 0;
+        std::int64_t north_cell = 0;
+        int cols = 0;
+        int rows = 0;
+        std::vector<std::uint8_t> cells;
+    };
+    mutable CoverWindow window_;
 };
 
 // Sec. 1.1's two cameras (left at -0.65 m, right at +0.65 m) with every other
 // parameter at its default.
 CameraEmulatorParams seed001_camera_params(bool right_camera);
 
-// A box blur of radius r on each channel (kernel 2r + 1, edges clamped),
-// separable: two passes of running sums.
+// A box blur of radius r on each channel (kernel (2r + 1) x (2r + 1), edges
+// clamped): the mean of the window, rounded.
 void box_blur(rig::camera::RgbImage& image, int radius_px);
 
 }  // namespace rig::emulators::vision
