@@ -113,7 +113,8 @@ TEST(Falsify, FindsTheNarrowBandFaultWithinItsBudgetAndWorstYamlReproducesIt) {
     const auto search = run_shell(kRig + " falsify " + shell_word(kFalsifyCases / "lead-bump.search.yaml") +
                                   " --first --in-process --jobs 2 -q --out " + shell_word(dir / "out") + " 2>&1");
     ASSERT_EQ(search.exit_code, 1) << search.output;
-    EXPECT_NE(search.output.find("rig falsify: FALSIFIED"), std::string::npos) << search.output;
+    EXPECT_NE(search.output.find("rig falsify: FALSIFIED " RIG_SOURCE_DIR "/cases/falsify/lead-bump.yaml in "), std::string::npos)
+        << search.output;
     const nlohmann::json found = json_file(dir / "out" / "falsify.json");
     ASSERT_FALSE(found["first_falsifying"].is_null());
     const std::size_t first = found["first_falsifying"].get<std::size_t>();

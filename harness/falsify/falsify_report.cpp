@@ -182,12 +182,15 @@ std::string falsify_summary(const FalsifyRecord& record, const std::filesystem::
     const std::string counts = std::to_string(outcome.points.size()) + " point(s), " +
                                std::to_string(runs_made(record)) + " run(s)";
     const std::string worst_file = (out_dir / "worst.yaml").string();
+    const auto point_line = [&](std::size_t index) {
+        return "point " + std::to_string(index + 1) + ": " + point_text(record, outcome.points[index]) + ": margin " +
+               margin_text(outcome.points[index].margin) + " (" + margin_reason(record, index) + ")";
+    };
     if (outcome.first_falsifying) {
-        const std::size_t index = *outcome.first_falsifying;
-        return "rig falsify: FALSIFIED " + record.search_case.file.string() + " at point " + std::to_string(index + 1) +
-               " of " + counts + ": " + point_text(record, outcome.points[index]) + ": margin " +
-               margin_text(outcome.points[index].margin) + " (" + margin_reason(record, index) +
-               "); worst: " + worst_file;
+        std::string line = "rig falsify: FALSIFIED " + record.search_case.file.string() + " in " + counts +
+                           "; first at " + point_line(*outcome.first_falsifying);
+        if (outcome.worst && *outcome.worst != *outcome.first_falsifying) line += "; worst at " + point_line(*outcome.worst);
+        return line + "; worst: " + worst_file;
     }
     if (!outcome.worst) {
         return "rig falsify: no point of " + record.search_case.file.string() + " could be judged in " + counts +
