@@ -51,7 +51,7 @@ RunOptions default_run_options() {
 void add_setting_option(CLI::App& command, std::vector<std::string>& setting_texts) {
     command.add_option("--set", setting_texts,
                        "KEY=VALUE: replace the value the case file writes at KEY (e.g. vehicle.speed_km_h=9, "
-                       "gnss.dropouts[0].start_s=3), checked against the key's bounds like the file's own; repeatable")
+                       "gnss.dropouts[0].at_s=3), checked against the key's bounds like the file's own; repeatable")
         ->allow_extra_args(false);
 }
 

@@ -24,7 +24,7 @@
 namespace rig::harness {
 
 struct KeySetting {
-    // Dotted path with list indices, as errors print keys: `gnss.dropouts[0].start_s`.
+    // Dotted path with list indices, as errors print keys: `gnss.dropouts[0].at_s`.
     std::string key;
     // A plain YAML scalar: a number, true/false, or a word (a choice key's value).
     std::string value;
