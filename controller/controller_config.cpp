@@ -126,6 +126,11 @@ ControllerFaults read_faults(const YamlSection& section) {
         section.fail("section_chatter_closed_s", "must be shorter than section_chatter_period_s");
     }
     faults.lead_scale = section.optional_in_range("lead_scale", faults.lead_scale, Bounds::closed(0.0, 20.0));
+    faults.lead_bump_s = section.optional_in_range("lead_bump_s", faults.lead_bump_s, Bounds::closed(0.0, 10.0));
+    faults.lead_bump_at_km_h =
+        section.optional_in_range("lead_bump_at_km_h", faults.lead_bump_at_km_h, Bounds::closed(0.0, 30.0));
+    faults.lead_bump_half_width_km_h = section.optional_in_range(
+        "lead_bump_half_width_km_h", faults.lead_bump_half_width_km_h, Bounds::open_closed(0.0, 30.0));
     faults.valve_held = section.optional<bool>("valve_held", faults.valve_held);
     faults.stale_fix_reanchor = section.optional<bool>("stale_fix_reanchor", faults.stale_fix_reanchor);
     faults.boom_height_read_once = section.optional<bool>("boom_height_read_once", faults.boom_height_read_once);
@@ -141,7 +146,8 @@ ControllerFaults read_faults(const YamlSection& section) {
 }  // namespace
 
 bool ControllerFaults::any() const {
-    return never_resume || never_spray || section_chatter_period_s > 0.0 || lead_scale != 1.0 || valve_held ||
+    return never_resume || never_spray || section_chatter_period_s > 0.0 || lead_scale != 1.0 || lead_bump_s > 0.0 ||
+           valve_held ||
            stale_fix_reanchor || boom_height_read_once || crash_at_s >= 0.0 || stall_at_s >= 0.0 || !read_topic.empty() || !write_topic.empty();
 }
 

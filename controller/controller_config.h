@@ -43,6 +43,14 @@ struct ControllerFaults {
     double section_chatter_period_s = 0.0;
     double section_chatter_closed_s = 0.05;
     double lead_scale = 1.0;                // multiplies Eq. 7's lead v (t2 + t3): 2 opens twice as early
+    // > 0: a lead table with one bad entry. Eq. 7's lead gets lead_bump_s more
+    // seconds of travel at lead_bump_at_km_h, tapering linearly to none
+    // lead_bump_half_width_km_h either side (the interpolation between the
+    // table's entries): a fault that bites in a narrow band of speed only
+    // (the known answer rig falsify's tests look for, docs/falsify.md).
+    double lead_bump_s = 0.0;
+    double lead_bump_at_km_h = 6.0;
+    double lead_bump_half_width_km_h = 0.3;
     bool valve_held = false;                // the ball valve is never driven after the power-on reset (no pre-adjustment, no PID)
     // Keeps acting on a stale fix through a dropout: while GGA is missing it
     // re-feeds the last fix as a new one every receiver epoch, and every fix

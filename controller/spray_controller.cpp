@@ -324,7 +324,12 @@ double SprayController::continuation_lead_m() const {
     const double lead_m = config_.hysteresis_compensation
                               ? speed_m_s() * (config_.assumed_flow_adjust_s + config_.assumed_spray_delay_s)
                               : 0.0;
-    return lead_m * config_.faults.lead_scale;  // TEST-ONLY fault: a wrong lead
+    // TEST-ONLY faults: a wrong lead, and a lead table's bad entry (a bump in speed).
+    const ControllerFaults& faults = config_.faults;
+    const double off_bump_km_h = std::fabs(speed_m_s() * 3.6 - faults.lead_bump_at_km_h);
+    const double bump_s =
+        faults.lead_bump_s * std::max(0.0, 1.0 - off_bump_km_h / faults.lead_bump_half_width_km_h);
+    return lead_m * faults.lead_scale + speed_m_s() * bump_s;
 }
 
 bool SprayController::continuation_open_point_reached(TimeNs now_ns) const {

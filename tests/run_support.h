@@ -22,6 +22,9 @@ inline std::filesystem::path fresh_dir(const std::string& name) {
     return dir;
 }
 
+// A path as one word of a shell command line (single-quoted).
+inline std::string shell_word(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
+
 // A whole file as text ("" when it cannot be read: the caller's assertion says what was expected).
 inline std::string read_all(const std::filesystem::path& path) {
     std::ifstream in(path);

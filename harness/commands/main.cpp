@@ -8,6 +8,7 @@
 //   rig dds-check               harness/commands/dds_check_command.h
 //   rig mcap                    harness/commands/mcap_command.h
 //   rig history                 harness/commands/history_command.h
+//   rig falsify                 harness/commands/falsify_command.h
 //   rig nmea decode             harness/bench/nmea_decode_tool.h
 //   rig pty, rig hid, rig emulate gnss, rig modbus serve   harness/bench/
 // A usage error (unknown command or option, missing or bad value) names the
@@ -29,6 +30,7 @@
 #include "harness/commands/compare_command.h"
 #include "harness/commands/dds_check_command.h"
 #include "harness/commands/diff_command.h"
+#include "harness/commands/falsify_command.h"
 #include "harness/commands/history_command.h"
 #include "harness/commands/judge_command.h"
 #include "harness/commands/mcap_command.h"
@@ -127,6 +129,7 @@ int main(int argc, char** argv) {
     commands.push_back(std::make_unique<MergeCommand>(app));
     commands.push_back(std::make_unique<DiffCommand>(app));
     commands.push_back(std::make_unique<SweepCommand>(app));
+    commands.push_back(std::make_unique<FalsifyCommand>(app));
     commands.push_back(std::make_unique<CompareCommand>(app));
     commands.push_back(std::make_unique<NmeaCommand>(app));
     commands.push_back(std::make_unique<PtyBenchCommand>(app));

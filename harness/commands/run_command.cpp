@@ -48,6 +48,27 @@ RunOptions default_run_options() {
     return options;
 }
 
+void add_setting_option(CLI::App& command, std::vector<std::string>& setting_texts) {
+    command.add_option("--set", setting_texts,
+                       "KEY=VALUE: replace the value the case file writes at KEY (e.g. vehicle.speed_km_h=9, "
+                       "gnss.dropouts[0].at_s=3), checked against the key's bounds like the file's own; repeatable")
+        ->allow_extra_args(false);
+}
+
+std::optional<std::vector<KeySetting>> parse_setting_texts(const std::vector<std::string>& texts,
+                                                           const std::string& command) {
+    std::vector<KeySetting> settings;
+    for (const std::string& text : texts) {
+        try {
+            settings.push_back(parse_key_setting(text));
+        } catch (const std::invalid_argument& error) {
+            std::cerr << command << ": --set " << error.what() << "\n";
+            return std::nullopt;
+        }
+    }
+    return settings;
+}
+
 namespace {
 
 // What a shard of a run or a sweep holds, said on standard error before it runs.
@@ -60,15 +81,15 @@ void say_shard(const std::string& command, const Shard& shard, std::size_t held,
 // Every case file read and validated before anything starts (the errors go to
 // standard error, and nothing is run: nullopt).
 std::optional<std::vector<CaseSpec>> load_cases(const std::vector<std::string>& inputs,
-                                                              const RunOptions& options,
-                                                              const std::optional<Shard>& shard) {
+                                                const std::vector<KeySetting>& settings, const RunOptions& options,
+                                                const std::optional<Shard>& shard) {
     std::vector<CaseSpec> specs;
     try {
         // Every file is read and validated before anything starts.
         std::vector<std::string> errors;
         for (const auto& path : expand_case_paths(inputs)) {
             try {
-                specs.push_back(load_case_file(path));
+                specs.push_back(load_case_file(path, settings));
                 validate_for_run(specs.back(), options);
             } catch (const std::exception& error) {
                 errors.push_back(error.what());
@@ -178,9 +199,10 @@ bool write_bencher_file(const std::string& command, const std::string& bmf_file,
     }
 }
 
-int run_command(const std::vector<std::string>& inputs, const RunOptions& options,
-                const std::optional<Shard>& shard, Verbosity verbosity, const std::string& bmf_file) {
-    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, shard);
+int run_command(const std::vector<std::string>& inputs, const std::vector<KeySetting>& settings,
+                const RunOptions& options, const std::optional<Shard>& shard, Verbosity verbosity,
+                const std::string& bmf_file) {
+    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, settings, options, shard);
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
     // An output directory that cannot take results is refused now, not after the cases ran.
@@ -284,6 +306,7 @@ private:
 };
 
 struct SweepArguments {
+    std::vector<KeySetting> settings;
     std::uint64_t seeds = 0;
     std::uint64_t first_seed = 1;
     std::string keep_traces = "failed";
@@ -301,7 +324,7 @@ int sweep_command(const std::vector<std::string>& inputs, RunOptions options, co
     }
     for (std::uint64_t k = 0; k < sweep.seeds; ++k) options.seed_sweep.push_back(sweep.first_seed + k);
     options.keep_figures = false;
-    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, options, std::nullopt);
+    std::optional<std::vector<CaseSpec>> loaded = load_cases(inputs, sweep.settings, options, std::nullopt);
     if (!loaded) return 2;
     const std::vector<CaseSpec>& specs = *loaded;
     // Every case file was checked above, whichever shard its runs are in.
@@ -381,6 +404,7 @@ RunCommand::RunCommand(CLI::App& app) : options_(default_run_options()) {
         "--shard", shard_text_,
         "I/N: run only shard I of N of the cases (by name, stable), e.g. one job of a CI matrix; rig merge joins them");
     run->add_option("--bmf", bmf_file_, "also write every case's metrics in Bencher's JSON format to this file");
+    add_setting_option(*run, setting_texts_);
     run->add_flag("--in-process", options_.in_process,
                   "software-in-the-loop: run each lockstep case's controller from its plugin inside the rig's process "
                   "(a case's controller.in_process wins; others run as processes, saying why)");
@@ -412,8 +436,10 @@ int RunCommand::run() {
     }
     std::optional<Shard> shard;
     if (!shard_option_value(shard_option_, shard_text_, "rig run", shard)) return 2;
+    const std::optional<std::vector<KeySetting>> settings = parse_setting_texts(setting_texts_, "rig run");
+    if (!settings) return 2;
     const auto verbosity = quiet_ ? Verbosity::quiet : verbose_ ? Verbosity::verbose : Verbosity::normal;
-    return run_command(inputs_, options, shard, verbosity, bmf_file_);
+    return run_command(inputs_, *settings, options, shard, verbosity, bmf_file_);
 }
 
 SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
@@ -439,12 +465,15 @@ SweepCommand::SweepCommand(CLI::App& app) : options_(default_run_options()) {
                                       "turn), e.g. one job of a CI matrix; rig merge joins them");
     sweep->add_flag("--quiet,-q", quiet_, "print only the summary line: no progress, no table");
     sweep->add_option("--bmf", bmf_file_, "also write every case's metrics (median, min, max) in Bencher's JSON format to this file");
+    add_setting_option(*sweep, setting_texts_);
 }
 
 bool SweepCommand::parsed() const { return command_->parsed(); }
 
 int SweepCommand::run() {
-    SweepArguments sweep{seeds_, first_seed_, keep_traces_, bmf_file_, std::nullopt};
+    const std::optional<std::vector<KeySetting>> settings = parse_setting_texts(setting_texts_, "rig sweep");
+    if (!settings) return 2;
+    SweepArguments sweep{*settings, seeds_, first_seed_, keep_traces_, bmf_file_, std::nullopt};
     if (!shard_option_value(shard_option_, shard_text_, "rig sweep", sweep.shard)) return 2;
     return sweep_command(inputs_, options_, sweep, quiet_ ? Verbosity::quiet : Verbosity::normal);
 }

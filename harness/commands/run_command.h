@@ -3,14 +3,16 @@
 // before anything starts, run (harness/run/case_runner.h) and judged, the
 // results written (harness/report/) and the table printed.
 //   rig run CASE_OR_DIR... [--out DIR] [--seed N] [--jobs N] [--in-process | --dds-security] [--domain N]
-//                          [--shard I/N] [--no-pin] [--quiet | --verbose]
+//                          [--set KEY=VALUE]... [--shard I/N] [--no-pin] [--quiet | --verbose]
 //   rig sweep CASE_OR_DIR... --seeds N [--first-seed N] [--keep-traces failed|all|none] [--out DIR] [--jobs N]
-//                          [--shard I/N] [--in-process] [--no-pin] [--quiet]
+//                          [--set KEY=VALUE]... [--shard I/N] [--in-process] [--no-pin] [--quiet]
+// --set replaces a value every case file given writes (harness/spec/case_settings.h).
 // Exit status of both: 0 all passed, 1 a case failed, 2 a usage or case-file
 // error (nothing ran), 3 (run) nothing failed but a real-time case was invalid,
 // 4 the results could not be written, 128 + N after signal N.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,13 @@ namespace rig::harness {
 RunOptions default_run_options();
 // The folder `rig` runs from.
 std::filesystem::path own_directory();
+
+// `--set KEY=VALUE`, on `command` (rig run, rig sweep, rig falsify's base).
+void add_setting_option(CLI::App& command, std::vector<std::string>& setting_texts);
+// --set's texts parsed; nullopt after saying on standard error what is wrong
+// with one (the caller exits 2).
+std::optional<std::vector<KeySetting>> parse_setting_texts(const std::vector<std::string>& texts,
+                                                           const std::string& command);
 
 class RunCommand final : public Subcommand {
 public:
@@ -50,6 +59,7 @@ private:
     bool verbose_ = false;
     bool dds_security_ = false;
     std::string bmf_file_;
+    std::vector<std::string> setting_texts_;
 };
 
 class SweepCommand final : public Subcommand {
@@ -71,6 +81,7 @@ private:
     CLI::Option* shard_option_ = nullptr;
     bool quiet_ = false;
     std::string bmf_file_;
+    std::vector<std::string> setting_texts_;
 };
 
 // The help text of --no-pin, shared with `rig bench`.

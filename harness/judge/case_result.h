@@ -41,6 +41,9 @@ struct CaseResult {
     std::string case_sha256;
     std::string controller_sha256;
     std::string controller_config_sha256;
+    // `rig run --set KEY=VALUE`: the case file's values the command line
+    // replaced (key path -> the value as given); empty when none.
+    std::map<std::string, std::string> settings;
     // The case's `compare.min_effect`: rig compare's minimum effects over the declared ones.
     std::map<std::string, double> min_effects;
     double sim_seconds = 0.0;

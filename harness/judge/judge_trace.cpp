@@ -132,6 +132,13 @@ CaseRun judge_trace(const RecordedTrace& trace, const SystemJudge& system) {
     result.controller_sha256 = trace.meta_or("controller_sha256");
     result.controller_config_sha256 = trace.meta_or("controller_config_sha256");
     try {
+        const nlohmann::json settings = nlohmann::json::parse(trace.meta_or("case_settings", "{}"));
+        for (const auto& [key, value] : settings.items()) result.settings[key] = value.get<std::string>();
+    } catch (const nlohmann::json::exception&) {
+        result.error_kind = "harness_error";
+        result.error = "trace " + trace.file.string() + ": meta case_settings is not an object of texts";
+    }
+    try {
         result.seed = std::stoull(trace.meta_or("seed", "0"));
         result.sim_seconds = ns_to_seconds(std::stoll(trace.meta_or("end_ns", "0")));
     } catch (const std::exception&) {

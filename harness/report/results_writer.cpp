@@ -147,6 +147,9 @@ void add_run_identity(const CaseResult& result, nlohmann::json& run) {
     run["controller_sha256"] = text_or_null(result.controller_sha256);
     run["controller_config_sha256"] = text_or_null(result.controller_config_sha256);
     run["min_effects"] = result.min_effects;
+    nlohmann::json settings = nlohmann::json::object();
+    for (const auto& [key, value] : result.settings) settings[valid_utf8(key)] = valid_utf8(value);
+    run["settings"] = std::move(settings);
     nlohmann::json not_measured = nlohmann::json::object();
     for (const auto& [name, why] : result.not_measured) not_measured[valid_utf8(name)] = valid_utf8(why);
     run["not_measured"] = std::move(not_measured);

@@ -57,7 +57,8 @@ RunSummary summarize(const std::vector<CaseResult>& results);
 nlohmann::json results_json(const std::vector<CaseResult>& results, const RunSummary& summary);
 // A run's identity and what it did not measure, as results.json and sweep.json
 // write them for each run: `case`, `case_sha256`, `controller_sha256`,
-// `controller_config_sha256` (null when not recorded), `min_effects`, `not_measured`.
+// `controller_config_sha256` (null when not recorded), `min_effects`, `not_measured`,
+// `settings` (`rig run --set`: key path -> value as given; {} when none).
 void add_run_identity(const CaseResult& result, nlohmann::json& run);
 
 // JUnit XML, valid against Jenkins xunit's JUnit schema (tests/data/jenkins-junit-10.xsd):

@@ -43,6 +43,7 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
     result.file = spec.source_path.string();
     result.seed = seed;
     result.case_sha256 = case_content_sha256(spec);
+    for (const KeySetting& setting : spec.settings) result.settings[setting.key] = setting.value;
     result.mode = std::string(to_string(spec.mode));
     result.limits = effective_limits(spec);
     result.min_effects = spec.min_effects;
@@ -57,6 +58,13 @@ CaseRun unstarted_run(const CaseSpec& spec, std::uint64_t seed, const std::strin
     result.expected_failure = verdict.expected_failure;
     result.passed = verdict.passed;
     return run;
+}
+
+// `rig run --set`'s values, as meta `case_settings` keeps them: key path -> value as given.
+nlohmann::json settings_json(const CaseSpec& spec) {
+    nlohmann::json settings = nlohmann::json::object();
+    for (const KeySetting& setting : spec.settings) settings[setting.key] = setting.value;
+    return settings;
 }
 
 // What the judge will hold the controller to (meta `judging`): the common part
@@ -240,6 +248,7 @@ CaseRun run_case(const CaseSpec& spec, std::uint64_t seed, const std::string& ru
         trace.file().set_meta("case_name", spec.name);
         trace.file().set_meta("case_file", spec.source_path.string());
         trace.file().set_meta("case_yaml", spec.source_text);
+        if (!spec.settings.empty()) trace.file().set_meta("case_settings", settings_json(spec).dump());
         trace.file().set_meta("system", std::string(system.name()));
         trace.file().set_meta("scenario", spec.system->scenario());
         trace.file().set_meta("mode", std::string(to_string(spec.mode)));

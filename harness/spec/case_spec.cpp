@@ -378,14 +378,37 @@ std::map<std::string, double> effective_limits(const CaseSpec& spec) {
     return limits;
 }
 
-CaseSpec read_case_text(std::string_view yaml_text, const std::filesystem::path& file_name,
-                        std::span<const SystemSectionsReader> systems) {
-    CaseSpec spec = read_case(YamlSection::load_string(yaml_text, file_name.string()), file_name, systems);
-    spec.source_text = std::string(yaml_text);
-    return spec;
+namespace {
+
+// The case read from `text` with `settings` applied; an error at a key a
+// setting gave says so, since the file's own value there is not the culprit.
+CaseSpec read_case_with_settings(std::string_view text, const std::filesystem::path& source_path,
+                                 std::span<const SystemSectionsReader> systems, std::span<const KeySetting> settings) {
+    const std::string applied = apply_key_settings(text, source_path.string(), settings);
+    try {
+        CaseSpec spec = read_case(YamlSection::load_string(applied, source_path.string()), source_path, systems);
+        spec.source_text = applied;
+        spec.settings.assign(settings.begin(), settings.end());
+        return spec;
+    } catch (const ConfigError& error) {
+        for (const KeySetting& setting : settings) {
+            if (setting.key != error.key_path()) continue;
+            throw ConfigError(error.where(), error.message() + " (the value of --set " + setting.key + "=" +
+                                                 setting.value + ")");
+        }
+        throw;
+    }
 }
 
-CaseSpec read_case_file(const std::filesystem::path& path, std::span<const SystemSectionsReader> systems) {
+}  // namespace
+
+CaseSpec read_case_text(std::string_view yaml_text, const std::filesystem::path& file_name,
+                        std::span<const SystemSectionsReader> systems, std::span<const KeySetting> settings) {
+    return read_case_with_settings(yaml_text, file_name, systems, settings);
+}
+
+CaseSpec read_case_file(const std::filesystem::path& path, std::span<const SystemSectionsReader> systems,
+                        std::span<const KeySetting> settings) {
     // Read once, by type and bounded (rig/config/file_access.h), then parsed from memory;
     // the text is kept for the trace.
     std::string text;
@@ -395,9 +418,7 @@ CaseSpec read_case_file(const std::filesystem::path& path, std::span<const Syste
     } catch (const FileAccessError& error) {
         throw ConfigError(SourceLocation{path.string(), 0, 0, "(file)"}, error.problem());
     }
-    CaseSpec spec = read_case(YamlSection::load_string(text, path.string()), path, systems);
-    spec.source_text = text;
-    return spec;
+    return read_case_with_settings(text, path, systems, settings);
 }
 
 namespace {
@@ -451,6 +472,11 @@ void check_common_timeline(const CaseSpec& spec, double case_end_s) {
     }
 }
 
+bool is_search_file(const std::filesystem::path& path) {
+    const std::string name = path.filename().string();
+    return name.size() > kSearchFileSuffix.size() && name.ends_with(kSearchFileSuffix);
+}
+
 std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args) {
     namespace fs = std::filesystem;
     std::vector<fs::path> paths;
@@ -478,6 +504,7 @@ std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::stri
             }
             const std::string extension = it->path().extension().string();
             if (extension != ".yaml" && extension != ".yml") continue;
+            if (is_search_file(it->path())) continue;
             // A folder named like a case is walked into; anything else with a case's
             // name (a FIFO, a link to a device, a link loop) is kept, for
             // load_case_file to refuse by type, naming it, rather than skipped unsaid.

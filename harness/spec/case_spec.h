@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "harness/spec/board_spec.h"
+#include "harness/spec/case_settings.h"
 #include "harness/spec/realtime_spec.h"
 #include "rig/config/config_error.h"
 #include "rig/config/yaml_fields.h"
@@ -170,7 +171,11 @@ struct CaseSpec {
     // `seeds: [..]` instead of `seed`: the case runs once per seed, as NAME-seedN
     // (a faulty controller must be caught on every one).
     std::vector<std::uint64_t> seeds;
-    std::string source_text;  // the file as written (kept in the trace)
+    std::string source_text;  // the file as written, with `settings` applied (kept in the trace)
+    // `rig run --set KEY=VALUE`: values given on the command line in place of
+    // the file's (harness/spec/case_settings.h), in the order given; recorded
+    // in the trace (meta `case_settings`) and results.json.
+    std::vector<KeySetting> settings;
     ClockMode mode = ClockMode::lockstep;
     // The system's own sections (`system:`; harness/systems/ reads them). Set by
     // the loader for every case it returns.
@@ -225,11 +230,14 @@ struct SystemSectionsReader {
 inline constexpr std::string_view kDefaultSystem = "breakpoint";
 
 // Parses and validates a case file; throws rig::ConfigError. The sections of
-// its system are read by the reader of that name in `systems`.
-CaseSpec read_case_file(const std::filesystem::path& path, std::span<const SystemSectionsReader> systems);
+// its system are read by the reader of that name in `systems`. `settings`
+// replace values of the file before it is read (harness/spec/case_settings.h):
+// an error at a set key says the value came from the command line.
+CaseSpec read_case_file(const std::filesystem::path& path, std::span<const SystemSectionsReader> systems,
+                        std::span<const KeySetting> settings = {});
 // The same from text in memory; `file_name` is what errors call it.
 CaseSpec read_case_text(std::string_view yaml_text, const std::filesystem::path& file_name,
-                        std::span<const SystemSectionsReader> systems);
+                        std::span<const SystemSectionsReader> systems, std::span<const KeySetting> settings = {});
 
 // Two cases of one run with one name would share cases/NAME/ (trace, log,
 // controller state): one line per later case whose name an earlier one has,
@@ -246,9 +254,14 @@ void check_event_in_case(double at_s, double for_s, const SourceLocation& at_whe
 // The common part of a case's timeline: the rig's own stall (rig_faults).
 void check_common_timeline(const CaseSpec& spec, double case_end_s);
 
+// `rig falsify`'s search files (docs/falsify.md) sit beside their cases and
+// are named NAME.search.yaml: they describe a search, not a case.
+inline constexpr std::string_view kSearchFileSuffix = ".search.yaml";
+bool is_search_file(const std::filesystem::path& path);
+
 // Command-line case arguments to files: a file stays as given; a directory
-// becomes the `*.yaml` / `*.yml` files anywhere below it (hidden files and
-// folders skipped), sorted by path relative to it. A missing path, or a directory with no case files, is
+// becomes the `*.yaml` / `*.yml` files anywhere below it (hidden files,
+// folders and search files skipped), sorted by path relative to it. A missing path, or a directory with no case files, is
 // a rig::ConfigError naming it.
 std::vector<std::filesystem::path> expand_case_paths(const std::vector<std::string>& args);
 

@@ -40,7 +40,9 @@ std::vector<SystemSectionsReader> system_section_readers() {
     return readers;
 }
 
-CaseSpec load_case_file(const std::filesystem::path& path) { return read_case_file(path, system_section_readers()); }
+CaseSpec load_case_file(const std::filesystem::path& path, std::span<const KeySetting> settings) {
+    return read_case_file(path, system_section_readers(), settings);
+}
 
 CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name) {
     return read_case_text(yaml_text, file_name, system_section_readers());

@@ -6,6 +6,7 @@
 // sections by its `system:`), judge a trace (by its meta `system`), and name
 // the systems there are, and say which signals of a trace show what its run did.
 #include <filesystem>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -27,8 +28,9 @@ const System& system_of(const CaseSpec& spec);
 std::vector<SystemSectionsReader> system_section_readers();
 
 // Parses and validates a case file (the sections every case has, then its
-// system's); throws rig::ConfigError naming file, line and key.
-CaseSpec load_case_file(const std::filesystem::path& path);
+// system's), with `settings` in place of the file's values (`rig run --set`);
+// throws rig::ConfigError naming file, line and key.
+CaseSpec load_case_file(const std::filesystem::path& path, std::span<const KeySetting> settings = {});
 // The same from text in memory; `file_name` is what errors call it.
 CaseSpec parse_case(std::string_view yaml_text, const std::filesystem::path& file_name);
 
