@@ -1,16 +1,19 @@
 #include "harness/falsify/robustness.h"
 
 #include <cmath>
+#include <optional>
+
+#include "rig/runtime/failure_kind.h"
 
 namespace rig::harness {
 
 namespace {
 
 // Errors that are the rig's, not the controller's: the run says nothing of
-// the controller at this point (harness/judge/verdict.h case_invalid and
-// rig::FailureKind).
+// the controller at this point (rig/runtime/failure_kind.h).
 bool rig_error(const std::string& kind) {
-    return kind == "harness_error" || kind == "interrupted" || kind == "rig_overloaded";
+    const std::optional<rig::FailureKind> known = rig::failure_kind_from_string(kind);
+    return known && rig::is_rigs_own_failure(*known);
 }
 
 }  // namespace

@@ -31,6 +31,11 @@ std::string_view to_string(FailureKind kind) {
     return "harness_error";
 }
 
+bool is_rigs_own_failure(FailureKind kind) {
+    return kind == FailureKind::interrupted || kind == FailureKind::harness_error ||
+           kind == FailureKind::rig_overloaded;
+}
+
 std::optional<FailureKind> failure_kind_from_string(std::string_view name) {
     for (const auto& [value, known] : kFailureKindNames) {
         if (known == name) return value;

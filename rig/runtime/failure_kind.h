@@ -29,6 +29,10 @@ enum class FailureKind {
                            // the run is invalid, it cannot judge the controller (docs/metrics.md "Verdicts")
 };
 std::string_view to_string(FailureKind kind);
+// True for the kinds that are the rig's own failure, not the controller's
+// (interrupted, harness_error, rig_overloaded): such a run says nothing of the
+// controller, and a search over cases must not count it for or against it.
+bool is_rigs_own_failure(FailureKind kind);
 // The kind with this name; nullopt for an unknown one.
 std::optional<FailureKind> failure_kind_from_string(std::string_view name);
 // Every kind, for validation messages ("one of: ...").
