@@ -153,6 +153,71 @@ TEST(SearchSpace, RangesParseSnapAndWriteValuesExactly) {
     }
 }
 
+TEST(SearchSpace, ChoiceKeysParseSnapToAChoiceAndWriteTheChoice) {
+    const VaryRange positioning = parse_vary("controller.positioning=fusion,rtk_only");
+    EXPECT_EQ(positioning.key, "controller.positioning");
+    ASSERT_TRUE(positioning.is_choice());
+    EXPECT_EQ(positioning.choices, (std::vector<std::string>{"fusion", "rtk_only"}));
+    EXPECT_EQ(range_text(positioning), "controller.positioning=fusion,rtk_only");
+    // [0, 1) is the first choice, [1, 2] the second: half the range each.
+    EXPECT_EQ(value_text(positioning, 0.0), "fusion");
+    EXPECT_EQ(value_text(positioning, 0.999), "fusion");
+    EXPECT_EQ(value_text(positioning, 1.0), "rtk_only");
+    EXPECT_EQ(value_text(positioning, 2.0), "rtk_only");  // the range's top end is the last choice
+    EXPECT_EQ(value_text(positioning, -3.0), "fusion");
+    // A choice's unit coordinate is the middle of its share, and maps back to it.
+    EXPECT_DOUBLE_EQ(unit_of(positioning, 1.0), 0.75);
+    EXPECT_EQ(snapped(positioning, positioning.low + unit_of(positioning, 0.0) * positioning.high), 0.0);
+    const auto settings = point_settings({}, {positioning}, {1.0});
+    ASSERT_EQ(settings.size(), 1u);
+    EXPECT_EQ(settings[0].value, "rtk_only");
+    // Numbers can be choices too: a discrete set of values.
+    const VaryRange pulses = parse_vary("encoder.pulses_per_rev=500,1000,2000");
+    EXPECT_EQ(value_text(pulses, 2.5), "2000");
+    for (const char* bad : {"controller.positioning=fusion", "controller.positioning=fusion,fusion",
+                            "controller.positioning=fusion,", "controller.positioning=,fusion",
+                            "controller.positioning=fusion,rtk only", "controller.positioning="}) {
+        EXPECT_THROW(parse_vary(bad), std::invalid_argument) << bad;
+    }
+}
+
+// A margin that breaks only at one choice of a choice key, and there only
+// in a band of a number: the search finds the pair, and visits every choice.
+class ChoiceEvaluator final : public PointEvaluator {
+public:
+    std::vector<RunMargin> evaluate(const std::vector<std::vector<double>>& points) override {
+        std::vector<RunMargin> margins;
+        for (const auto& point : points) {
+            RunMargin margin;
+            const bool bites = point[0] == 2.0;  // the third choice
+            margin.margin = 0.4 - (bites ? 0.6 * std::max(0.0, 1.0 - std::fabs(point[1] - 8.0) / 2.0) : 0.0);
+            margin.limiting_metric = "overlap_m";
+            margins.push_back(margin);
+            choices_seen.insert(point[0]);
+        }
+        return margins;
+    }
+    bool stopped() const override { return false; }
+    std::set<double> choices_seen;
+};
+
+TEST(FalsifySearch, FindsTheOneChoiceThatBreaksAndVisitsEveryChoice) {
+    const std::vector<VaryRange> space{parse_vary("gnss.fix=rtk,float,dgps"), parse_vary("vehicle.speed_km_h=3:12")};
+    for (const SearchMethod method : {SearchMethod::crs2, SearchMethod::direct}) {
+        SearchOptions options;
+        options.method = method;
+        options.budget = 60;
+        options.stop_at_first = true;
+        ChoiceEvaluator evaluator;
+        const SearchOutcome outcome = falsify_search(space, options, evaluator);
+        ASSERT_TRUE(outcome.first_falsifying.has_value()) << search_method_name(method);
+        const SearchedPoint& found = outcome.points[*outcome.first_falsifying];
+        EXPECT_EQ(value_text(space[0], found.values[0]), "dgps");
+        EXPECT_NEAR(found.values[1], 8.0, 2.0 / 3.0);  // where 0.6 * (1 - |v - 8| / 2) passes 0.4
+        EXPECT_EQ(evaluator.choices_seen, (std::set<double>{0.0, 1.0, 2.0})) << search_method_name(method);
+    }
+}
+
 TEST(FalsifySearch, Crs2FindsANarrowNotchWithinItsBudgetDeterministically) {
     // The notch breaks the limit where |x0 - 7.7| < 0.1 (2.2 % of the range), its slope within 0.6.
     SearchOptions options;

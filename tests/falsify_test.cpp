@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -93,12 +94,47 @@ TEST(Falsify, BadRangesKeysAndMetricsAreRefusedByName) {
              {"the file writes no 'gnss.latency'", "did you mean 'gnss.latency_s'"}},
             {falsify + "--vary vehicle.speed_km_h=9:3", {"LO must be below HI"}},
             {falsify + "--vary controller.positioning=0:1", {"is 'fusion', not a number"}},
+            {falsify + "--vary controller.positioning=fusion,gps",
+             {"--vary controller.positioning=fusion,gps: at gps:", "controller.positioning"}},
+            {falsify + "--vary controller.positioning=fusion", {"two choices or more"}},
+            // The controller's section is checked as a run checks it, before anything runs.
+            {falsify + "--vary controller.threshold_m=0:5", {"--vary controller.threshold_m=0:5: at 0:", "threshold_m"}},
+            {falsify + "--vary controller.positioning=fusion,rtk_only --budget 1",
+             {"the choices give 2 combinations", "more than the budget of 1"}},
             {falsify + "--vary vehicle.speed_km_h=3:9 --metric overlap_m",
              {"--metric overlap_m: ", "its limited metrics: breakpoint_error_m"}},
             {falsify + "--vary encoder.pulses_per_rev=100.5:900", {"is a whole number"}},
             {falsify, {"nothing to vary"}},
         },
         fresh_dir("falsify_bad") / "out");
+}
+
+// A choice key is varied over its choices: each point's value is one of
+// them, as a word in falsify.json, and worst.yaml writes it into the case.
+TEST(Falsify, AChoiceKeyIsVariedOverItsChoicesAndWrittenIntoWorstYaml) {
+    const fs::path dir = fresh_dir("falsify_choice");
+    const auto search = run_shell(kRig + " falsify " + kShortCase +
+                                  " --vary controller.positioning=fusion,rtk_only --vary vehicle.speed_km_h=3:9"
+                                  " --budget 4 --start 4 --in-process --jobs 2 -q --out " +
+                                  shell_word(dir / "out") + " 2>&1");
+    ASSERT_LE(search.exit_code, 1) << search.output;
+    const nlohmann::json found = json_file(dir / "out" / "falsify.json");
+    EXPECT_EQ(found["vary"][0]["choices"], (nlohmann::json{"fusion", "rtk_only"}));
+    EXPECT_EQ(found["vary"][0]["base"], "fusion");
+    std::set<std::string> seen;
+    for (const nlohmann::json& point : found["points"]) {
+        seen.insert(point["parameters"]["controller.positioning"].get<std::string>());
+    }
+    // A Latin hypercube of 4 points puts 2 in each half of the choice's range.
+    EXPECT_EQ(seen, (std::set<std::string>{"fusion", "rtk_only"}));
+    ASSERT_FALSE(found["worst"].is_null()) << search.output;
+    const nlohmann::json& worst = found["points"][found["worst"].get<std::size_t>() - 1];
+    const std::string worst_yaml = read_all(dir / "out" / "worst.yaml");
+    const std::string positioning = worst["parameters"]["controller.positioning"].get<std::string>();
+    EXPECT_NE(worst_yaml.find("positioning: " + positioning), std::string::npos) << worst_yaml;
+    EXPECT_NE(worst_yaml.find("controller.positioning=fusion,rtk_only"), std::string::npos) << worst_yaml;
+    const std::string page = read_all(dir / "out" / "falsify.html");
+    EXPECT_NE(page.find("fusion, rtk_only"), std::string::npos);
 }
 
 // The reference controller with a TEST-ONLY fault (controller_config.h

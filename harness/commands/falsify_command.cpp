@@ -56,7 +56,8 @@ FalsifyCommand::FalsifyCommand(CLI::App& app) : options_(default_run_options()) 
     CLI::App* falsify = command_;
     falsify->add_option("case", input_, "the base case file, or a NAME.search.yaml file describing the search")
         ->required();
-    falsify->add_option("--vary", vary_texts_, "KEY=LO:HI: a numeric key of the case file and its range; repeatable")
+    falsify->add_option("--vary", vary_texts_, "KEY=LO:HI (a numeric key of the case file and its range) or KEY=A,B,... "
+                                         "(a key and its choices); repeatable")
         ->allow_extra_args(false);
     falsify->add_option("--metric", metrics_, "a limited metric to judge (default: every limited metric); repeatable")
         ->allow_extra_args(false);

@@ -83,8 +83,12 @@ nlohmann::json falsify_json(const FalsifyRecord& record) {
     const FalsifyCase& search = record.search_case;
     nlohmann::json vary = nlohmann::json::array();
     for (const VaryRange& range : search.ranges) {
-        vary.push_back({{"key", range.key}, {"low", range.low}, {"high", range.high}, {"integer", range.integer},
-                        {"base", range.base}});
+        if (range.is_choice()) {
+            vary.push_back({{"key", range.key}, {"choices", range.choices}, {"base", range.base_text}});
+        } else {
+            vary.push_back({{"key", range.key}, {"low", range.low}, {"high", range.high}, {"integer", range.integer},
+                            {"base", range.base}});
+        }
     }
     nlohmann::json settings = nlohmann::json::object();
     for (const KeySetting& setting : search.settings) settings[setting.key] = setting.value;
@@ -93,7 +97,14 @@ nlohmann::json falsify_json(const FalsifyRecord& record) {
         const SearchedPoint& point = record.outcome.points[index];
         const PointRuns& runs = record.point_runs[index];
         nlohmann::json parameters = nlohmann::json::object();
-        for (std::size_t key = 0; key < search.ranges.size(); ++key) parameters[search.ranges[key].key] = point.values[key];
+        for (std::size_t key = 0; key < search.ranges.size(); ++key) {
+            const VaryRange& range = search.ranges[key];
+            if (range.is_choice()) {
+                parameters[range.key] = value_text(range, point.values[key]);
+            } else {
+                parameters[range.key] = point.values[key];
+            }
+        }
         nlohmann::json seeds = nlohmann::json::array();
         for (std::size_t run = 0; run < runs.runs.size(); ++run) {
             const CaseResult& result = runs.runs[run];
@@ -163,7 +174,7 @@ std::string worst_case_text(const FalsifyRecord& record) {
     if (!record.search_file.empty()) header += "# (the search " + record.search_file.string() + ")\n";
     header += "# over";
     for (const VaryRange& range : record.search_case.ranges) {
-        header += " " + range.key + " " + shortest_text(range.low) + ".." + shortest_text(range.high);
+        header += " " + range_text(range);
     }
     header += ".\n# Margin " + margin_text(point.margin) + ": " + margin_reason(record, index) + ".\n";
     header += "# Written in below: " + settings_text(settings) + "\n";
@@ -206,6 +217,20 @@ namespace {
 
 bool counts_as_falsifying(const RunMargin& margin) { return margin.invalid.empty() && margin.falsifying(); }
 
+// A parameter's axis: its range, or its choices as named tics at their
+// indexes (where the points of a choice are drawn).
+std::string axis_script(const std::string& axis, const VaryRange& range) {
+    if (!range.is_choice()) {
+        return "set " + axis + "range [" + exact_number(range.low) + ":" + exact_number(range.high) + "]\n";
+    }
+    std::string tics;
+    for (std::size_t index = 0; index < range.choices.size(); ++index) {
+        tics += (index == 0 ? "" : ", ") + gnuplot_string(range.choices[index]) + " " + std::to_string(index);
+    }
+    return "set " + axis + "range [-0.5:" + exact_number(static_cast<double>(range.choices.size()) - 0.5) + "]\nset " +
+           axis + "tics (" + tics + ")\n";
+}
+
 // The margin over one parameter: each point, the falsifying ones marked, the
 // limit (margin 0) as a line; a broken point (no number) at the bottom.
 Panel parameter_panel(const FalsifyRecord& record, std::size_t key) {
@@ -234,7 +259,7 @@ Panel parameter_panel(const FalsifyRecord& record, std::size_t key) {
     script += data_block("passing", passing) + data_block("falsifying", falsifying) + data_block("broken", broken);
     script += "set title " + gnuplot_string("margin over " + range.key) + "\n";
     script += "set xlabel " + gnuplot_string(range.key) + "\nset ylabel 'margin (fraction of the limit)'\n";
-    script += "set xrange [" + exact_number(range.low) + ":" + exact_number(range.high) + "]\n";
+    script += axis_script("x", range);
     script += "set yrange " + margins.range(0.05, 0.08) + "\n";
     script += "set grid\nset key outside bottom center horizontal\n";
     script += "plot 0 with lines lw 2 dt 2 lc " + rgb(kLimitColor) + " title 'the limit (margin 0)', "
@@ -269,10 +294,10 @@ Panel pair_panel(const FalsifyRecord& record, std::size_t first, std::size_t sec
     script += data_block("points", points) + data_block("falsifying", falsifying);
     script += "set title " + gnuplot_string("margin over " + x.key + " and " + y.key) + "\n";
     script += "set xlabel " + gnuplot_string(x.key) + "\nset ylabel " + gnuplot_string(y.key) + "\n";
-    script += "set xrange [" + exact_number(x.low) + ":" + exact_number(x.high) + "]\n";
-    script += "set yrange [" + exact_number(y.low) + ":" + exact_number(y.high) + "]\n";
-    // Four points at least, or the grid is an artefact of too few.
-    const bool contour = points.size() >= 4;
+    script += axis_script("x", x) + axis_script("y", y);
+    // Four points at least, or the grid is an artefact of too few; and no
+    // contour across choices, between which nothing lies to interpolate.
+    const bool contour = points.size() >= 4 && !x.is_choice() && !y.is_choice();
     if (contour) {
         script += "set dgrid3d 40,40 qnorm 2\nset contour base\nset cntrparam levels discrete 0\nunset surface\n"
                   "set table $contour\nsplot $points using 1:2:3 with lines notitle\nunset table\n"
@@ -281,7 +306,9 @@ Panel pair_panel(const FalsifyRecord& record, std::size_t first, std::size_t sec
     script += "set palette defined (-1 '#d62728', 0 '#f7f7f7', 1 '#1f77b4')\n";
     script += "set cbrange [" + exact_number(-largest) + ":" + exact_number(largest) + "]\nset cblabel 'margin'\n";
     script += "set grid\nset key outside bottom center horizontal\n";
-    script += "plot $points using 1:2:3 with points pt 7 ps 1.1 lc palette title 'points (colour: margin)'";
+    // Each point outlined: a margin near 0 is near white in the palette.
+    script += "plot $points using 1:2:3 with points pt 7 ps 1.1 lc palette title 'points (colour: margin)', "
+              "$points using 1:2 with points pt 6 ps 1.1 lc rgb '#555555' notitle";
     if (contour) {
         script += ", $contour using 1:2 with lines lw 2 lc " + rgb(kLimitColor) + " title 'margin 0 (interpolated)'";
     }
@@ -343,8 +370,13 @@ std::string falsify_html(const FalsifyRecord& record, std::vector<std::string>& 
     out += ". A margin is (limit - value) / |limit|: below 0 the limit is broken.</p>\n";
     out += "<table><tr><th>key</th><th>range</th><th>base</th></tr>\n";
     for (const VaryRange& range : search.ranges) {
-        out += "<tr><td>" + html(range.key) + "</td><td>" + html(shortest_text(range.low) + " .. " + shortest_text(range.high)) +
-               "</td><td>" + html(shortest_text(range.base)) + "</td></tr>\n";
+        std::string values = shortest_text(range.low) + " .. " + shortest_text(range.high);
+        if (range.is_choice()) {
+            values.clear();
+            for (const std::string& choice : range.choices) values += (values.empty() ? "" : ", ") + choice;
+        }
+        out += "<tr><td>" + html(range.key) + "</td><td>" + html(values) + "</td><td>" + html(range.base_text) +
+               "</td></tr>\n";
     }
     out += "</table>\n";
     if (!problems.empty()) {

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <exception>
 #include <map>
+#include <optional>
 #include <random>
+#include <stdexcept>
 
 #include "harness/falsify/latin_hypercube.h"
 
@@ -17,22 +19,46 @@ namespace {
 class SearchState {
 public:
     SearchState(const std::vector<VaryRange>& space, const SearchOptions& options, PointEvaluator& evaluator)
-        : space_(space), options_(options), evaluator_(evaluator) {}
+        : space_(space), options_(options), evaluator_(evaluator), values_(space.size(), 0.0),
+          cell_limit_(options.budget) {
+        for (std::size_t index = 0; index < space.size(); ++index) free_.push_back(index);
+    }
 
+    // Searches one cell from now on: the choice keys at the given choices
+    // (their indexes, in the space's order), the other keys free, until the
+    // outcome holds `limit` points.
+    void enter_cell(const std::vector<double>& choices, std::size_t limit) {
+        free_.clear();
+        for (std::size_t index = 0, choice = 0; index < space_.size(); ++index) {
+            if (space_[index].is_choice()) {
+                values_[index] = choices.at(choice++);
+            } else {
+                free_.push_back(index);
+            }
+        }
+        cell_limit_ = std::min(limit, options_.budget);
+    }
+    std::size_t free_dimensions() const { return free_.size(); }
+
+    // A point of the free keys' unit cube, with the cell's choices.
     std::vector<double> values_of(const std::vector<double>& unit) const {
-        std::vector<double> values(space_.size());
-        for (std::size_t index = 0; index < space_.size(); ++index) {
-            const VaryRange& range = space_[index];
-            values[index] = snapped(range, range.low + std::clamp(unit[index], 0.0, 1.0) * (range.high - range.low));
+        std::vector<double> values = values_;
+        for (std::size_t free = 0; free < free_.size(); ++free) {
+            const VaryRange& range = space_[free_[free]];
+            values[free_[free]] = snapped(range, range.low + std::clamp(unit[free], 0.0, 1.0) * (range.high - range.low));
         }
         return values;
     }
 
-    bool done() const {
+    // The whole search is over: its budget spent, its first falsifying
+    // point found when asked for, or stopped.
+    bool finished() const {
         return outcome_.points.size() >= options_.budget || (options_.stop_at_first && outcome_.first_falsifying) ||
                evaluator_.stopped();
     }
-    std::size_t left() const { return options_.budget - outcome_.points.size(); }
+    // The cell's share of the budget is spent too.
+    bool done() const { return finished() || outcome_.points.size() >= cell_limit_; }
+    std::size_t left() const { return cell_limit_ - std::min(cell_limit_, outcome_.points.size()); }
 
     // Evaluates the unit points not yet evaluated (at most what the budget
     // leaves); returns each one's index in the outcome.
@@ -72,13 +98,17 @@ public:
         return highest_;
     }
 
-    // The best point so far on the unit cube (the design's centre before any).
+    // The cell's best point so far on its unit cube (the centre before any).
     std::vector<double> best_unit() const {
-        std::vector<double> unit(space_.size(), 0.5);
-        if (!outcome_.worst) return unit;
-        const std::vector<double>& values = outcome_.points[*outcome_.worst].values;
-        for (std::size_t index = 0; index < space_.size(); ++index) {
-            unit[index] = (values[index] - space_[index].low) / (space_[index].high - space_[index].low);
+        std::vector<double> unit(free_.size(), 0.5);
+        std::optional<std::size_t> best;
+        for (std::size_t at = 0; at < outcome_.points.size(); ++at) {
+            if (in_cell(outcome_.points[at].values) && (!best || objective_of(at) < objective_of(*best))) best = at;
+        }
+        if (!best) return unit;
+        const std::vector<double>& values = outcome_.points[*best].values;
+        for (std::size_t free = 0; free < free_.size(); ++free) {
+            unit[free] = unit_of(space_[free_[free]], values[free_[free]]);
         }
         return unit;
     }
@@ -86,6 +116,13 @@ public:
     SearchOutcome& outcome() { return outcome_; }
 
 private:
+    bool in_cell(const std::vector<double>& values) const {
+        for (std::size_t index = 0; index < space_.size(); ++index) {
+            if (space_[index].is_choice() && values[index] != values_[index]) return false;
+        }
+        return true;
+    }
+
     void note(std::size_t at) {
         const RunMargin& margin = outcome_.points[at].margin;
         if (!outcome_.first_falsifying && margin.invalid.empty() && margin.falsifying()) outcome_.first_falsifying = at;
@@ -113,6 +150,9 @@ private:
     std::map<std::vector<double>, std::size_t> index_of_;
     double lowest_ = 0.0;
     double highest_ = 0.0;
+    std::vector<std::size_t> free_;  // the keys the cell searches, by index in the space
+    std::vector<double> values_;     // the cell's choices (at the choice keys' indexes)
+    std::size_t cell_limit_;         // the points the outcome may hold at the cell's end
 };
 
 // Points on the unit cube in batches until the budget, or the first
@@ -230,21 +270,66 @@ std::size_t default_start_points(std::size_t dimensions, std::size_t budget, std
     return std::max<std::size_t>(1, std::min(wanted, std::max<std::size_t>(1, budget / 3)));
 }
 
+std::size_t choice_cells(const std::vector<VaryRange>& space) {
+    std::size_t cells = 1;
+    for (const VaryRange& range : space) {
+        if (range.is_choice()) cells *= range.choices.size();
+    }
+    return cells;
+}
+
+namespace {
+
+// One cell's search over its free keys with the points the budget leaves it.
+void search_cell(SearchState& state, const SearchOptions& options, std::uint64_t seed) {
+    const std::size_t dimensions = state.free_dimensions();
+    const std::size_t batch = std::max<std::size_t>(1, options.batch);
+    SearchOptions cell = options;
+    cell.seed = seed;
+    cell.batch = batch;
+    if (dimensions == 0) {  // only choices: the cell is one point
+        state.evaluate({std::vector<double>{}}, "start");
+        return;
+    }
+    if (options.method == SearchMethod::random) {
+        random_search(state, cell, dimensions);
+        return;
+    }
+    const std::size_t start = options.start_points > 0 ? std::min(options.start_points, state.left())
+                                                       : default_start_points(dimensions, state.left(), batch);
+    evaluate_in_batches(state, latin_hypercube(start, dimensions, seed), batch, "start");
+    if (!state.done()) nlopt_search(state, cell, dimensions);
+}
+
+}  // namespace
+
 SearchOutcome falsify_search(const std::vector<VaryRange>& space, const SearchOptions& options,
                              PointEvaluator& evaluator) {
     SearchState state(space, options, evaluator);
-    const std::size_t batch = std::max<std::size_t>(1, options.batch);
-    if (options.method == SearchMethod::random) {
-        SearchOptions batched = options;
-        batched.batch = batch;
-        random_search(state, batched, space.size());
-        return state.outcome();
+    // Choice keys split the search into cells, one per combination of
+    // choices, each searched over the numeric keys with an even share of
+    // what the budget leaves: a method that learns from margins would
+    // otherwise settle on the choice its first good point had, however
+    // badly another choice breaks (a choice has no slope to follow).
+    const std::size_t cells = choice_cells(space);
+    if (cells > options.budget) {
+        throw std::invalid_argument("the choices give " + std::to_string(cells) +
+                                    " combinations, more than the budget of " + std::to_string(options.budget) +
+                                    " points: raise --budget or list fewer choices");
     }
-    const std::size_t start =
-        options.start_points > 0 ? std::min(options.start_points, options.budget)
-                                 : default_start_points(space.size(), options.budget, batch);
-    evaluate_in_batches(state, latin_hypercube(start, space.size(), options.seed), batch, "start");
-    if (!state.done()) nlopt_search(state, options, space.size());
+    for (std::size_t cell = 0; cell < cells && !state.finished(); ++cell) {
+        std::vector<double> choices;
+        std::size_t rest = cell;
+        for (const VaryRange& range : space) {
+            if (!range.is_choice()) continue;
+            choices.push_back(static_cast<double>(rest % range.choices.size()));
+            rest /= range.choices.size();
+        }
+        const std::size_t used = state.outcome().points.size();
+        state.enter_cell(choices, used + (options.budget - used) / (cells - cell));
+        // Without choices the one cell's seed is the search's, as before choices existed.
+        search_cell(state, options, options.seed + cell);
+    }
     return state.outcome();
 }
 

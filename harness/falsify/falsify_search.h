@@ -15,6 +15,10 @@
 //   Or plain random sampling (`random`) with the same budget, batched like
 //   the start design: the baseline the benchmark compares with.
 //
+// With choice keys, the space is cut into one cell per combination of
+// choices, and each cell is searched so, the numeric keys free, with an even
+// share of the budget left.
+//
 // It stops when `budget` points have been evaluated, or after the first
 // falsifying point when asked. The search works on the unit cube, each
 // coordinate mapped onto its key's range and snapped (search_space.h).
@@ -73,6 +77,11 @@ struct SearchOutcome {
     std::size_t repeated_requests = 0;  // points NLopt asked for again (answered without a run)
 };
 
+// The number of combinations of the space's choice keys' choices (1 without
+// any): the search runs one cell per combination, each over the numeric keys.
+std::size_t choice_cells(const std::vector<VaryRange>& space);
+
+// Throws std::invalid_argument when the choices give more cells than the budget.
 SearchOutcome falsify_search(const std::vector<VaryRange>& space, const SearchOptions& options,
                              PointEvaluator& evaluator);
 

@@ -29,32 +29,72 @@ std::optional<double> number_of(const std::string& text) {
     return value;
 }
 
-std::string vary_text(const VaryRange& range) {
-    return "--vary " + range.key + "=" + shortest_text(range.low) + ":" + shortest_text(range.high);
+std::string vary_text(const VaryRange& range) { return "--vary " + range_text(range); }
+
+// The case with the range at `value`, loaded and checked as a run checks it
+// (the controller's section, the timeline), so that a bad end or choice is
+// refused before anything runs, not found invalid point by point.
+void check_case_at(const FalsifyRequest& request, const VaryRange& range, double value, const RunOptions& options) {
+    validate_for_run(load_case_file(request.case_file, point_settings(request.settings, {range}, {value})), options);
+}
+
+// Where and how the base case (with its settings applied) writes each of the
+// range's keys; a key it does not write is refused, naming the nearest it does.
+std::vector<WrittenValue> written_keys(const VaryRange& range, const FalsifyRequest& request,
+                                       const std::string& applied) {
+    std::vector<WrittenValue> written;
+    for (const std::string& key : range.keys) {
+        try {
+            written.push_back(written_value(applied, request.case_file.string(), key));
+        } catch (const ConfigError& error) {
+            throw std::invalid_argument(vary_text(range) + ": " + error.what());
+        }
+    }
+    return written;
+}
+
+// A choice key's keys in the base case: each written (the first's value is
+// the base), each choice a valid case: the loader refuses a word that is not
+// one of the key's own choices, or a number outside its bounds.
+void check_choices(VaryRange& range, const FalsifyRequest& request, const std::string& applied,
+                   const RunOptions& options) {
+    range.base_text = written_keys(range, request, applied).front().text;
+    const auto listed = std::find(range.choices.begin(), range.choices.end(), range.base_text);
+    range.base = listed == range.choices.end() ? -1.0 : static_cast<double>(listed - range.choices.begin());
+    for (std::size_t choice = 0; choice < range.choices.size(); ++choice) {
+        try {
+            check_case_at(request, range, static_cast<double>(choice), options);
+        } catch (const std::exception& error) {
+            throw std::invalid_argument(vary_text(range) + ": at " + range.choices[choice] + ": " + error.what());
+        }
+    }
 }
 
 // The range's keys in the base case: each written as a number (the first's
 // value is the base, and says whether the key is a whole number), each end of
 // the range a valid case.
-void check_range(VaryRange& range, const FalsifyRequest& request, const std::string& base_text) {
+void check_range(VaryRange& range, const FalsifyRequest& request, const std::string& base_text,
+                 const RunOptions& options) {
     const std::string file = request.case_file.string();
     const std::string applied = apply_key_settings(base_text, file, request.settings);
-    for (std::size_t index = 0; index < range.keys.size(); ++index) {
-        WrittenValue written;
-        try {
-            written = written_value(applied, file, range.keys[index]);
-        } catch (const ConfigError& error) {
-            throw std::invalid_argument(vary_text(range) + ": " + error.what());
-        }
+    if (range.is_choice()) {
+        check_choices(range, request, applied, options);
+        return;
+    }
+    const std::vector<WrittenValue> all_written = written_keys(range, request, applied);
+    for (std::size_t index = 0; index < all_written.size(); ++index) {
+        const WrittenValue& written = all_written[index];
         const std::optional<double> base = number_of(written.text);
         if (!base) {
             throw std::invalid_argument(vary_text(range) + ": " +
                                         ConfigError(written.where, "is '" + written.text +
-                                                                       "', not a number: a search varies numbers")
+                                                                       "', not a number: vary a word over its "
+                                                                       "choices, " + range.key + "=A,B")
                                             .what());
         }
         if (index > 0) continue;
         range.base = *base;
+        range.base_text = written.text;
         range.integer = whole_number_text(written.text);
     }
     if (range.integer && (range.low != std::floor(range.low) || range.high != std::floor(range.high))) {
@@ -63,8 +103,8 @@ void check_range(VaryRange& range, const FalsifyRequest& request, const std::str
     }
     for (const double end : {range.low, range.high}) {
         try {
-            (void)load_case_file(request.case_file, point_settings(request.settings, {range}, {end}));
-        } catch (const ConfigError& error) {
+            check_case_at(request, range, end, options);
+        } catch (const std::exception& error) {
             throw std::invalid_argument(vary_text(range) + ": at " + value_text(range, end) + ": " + error.what());
         }
     }
@@ -80,7 +120,7 @@ FalsifyRequest read_search_file(const std::filesystem::path& path) {
     const std::string case_name = search.required<std::string>("case");
     request.case_file = (path.parent_path() / case_name).lexically_normal();
     const std::vector<std::string> vary = search.string_list("vary");
-    if (search.has("vary") && vary.empty()) search.fail("vary", "no key to vary: give KEY=LO:HI items");
+    if (search.has("vary") && vary.empty()) search.fail("vary", "no key to vary: give KEY=LO:HI or KEY=A,B items");
     for (std::size_t index = 0; index < vary.size(); ++index) {
         try {
             request.ranges.push_back(parse_vary(vary[index]));
@@ -107,7 +147,9 @@ FalsifyRequest read_search_file(const std::filesystem::path& path) {
     request.options.seed = search.optional<std::uint64_t>("search_seed", request.options.seed);
     request.options.stop_at_first = search.optional<bool>("first", false);
     root.finish();
-    if (request.ranges.empty()) throw ConfigError(search.location(), "vary: required: the keys to vary, KEY=LO:HI");
+    if (request.ranges.empty()) {
+        throw ConfigError(search.location(), "vary: required: the keys to vary, KEY=LO:HI or KEY=A,B");
+    }
     std::error_code error;
     if (!std::filesystem::is_regular_file(request.case_file, error)) {
         throw ConfigError(search.location("case"), "no case file " + request.case_file.string());
@@ -116,7 +158,7 @@ FalsifyRequest read_search_file(const std::filesystem::path& path) {
 }
 
 PreparedSearch prepare_search(const FalsifyRequest& request, const RunOptions& options) {
-    if (request.ranges.empty()) throw std::invalid_argument("nothing to vary: give --vary KEY=LO:HI");
+    if (request.ranges.empty()) throw std::invalid_argument("nothing to vary: give --vary KEY=LO:HI or KEY=A,B");
     PreparedSearch prepared;
     prepared.base = load_case_file(request.case_file, request.settings);
     prepared.base_text = read_regular_file(request.case_file, OpenOptions{.no_follow = false,
@@ -140,7 +182,12 @@ PreparedSearch prepare_search(const FalsifyRequest& request, const RunOptions& o
                 }
             }
         }
-        check_range(search.ranges[index], request, prepared.base_text);
+        check_range(search.ranges[index], request, prepared.base_text, options);
+    }
+    if (const std::size_t cells = choice_cells(search.ranges); cells > request.options.budget) {
+        throw std::invalid_argument("the choices give " + std::to_string(cells) + " combinations, each searched "
+                                    "on its own, more than the budget of " + std::to_string(request.options.budget) +
+                                    " points: raise --budget or list fewer choices");
     }
     const std::map<std::string, double> limits = effective_limits(prepared.base);
     const std::vector<std::string> limited = limited_metrics(limits);

@@ -1,9 +1,9 @@
 #pragma once
 // A search asked for (on the command line, or in a `search:` file beside its
 // case) checked against its base case before anything runs: every varied key
-// written in the file as a number, each end of its range a valid case (the
-// key's own bounds, as the loader checks them), every metric asked for
-// limited in the case.
+// written in the file (as a number, unless varied over choices), each end of
+// its range and each choice a valid case (the key's own bounds and choices, as
+// the loader checks them), every metric asked for limited in the case.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -28,7 +28,7 @@ struct FalsifyRequest {
 // A `search:` file (named NAME.search.yaml, harness/spec/case_spec.h is_search_file):
 //   search:
 //     case: continuation.yaml              # relative to this file
-//     vary: [ "vehicle.speed_km_h=3:12", "gnss.latency_s=0.02:0.3" ]
+//     vary: [ "vehicle.speed_km_h=3:12", "controller.positioning=gnss,fusion" ]
 //     metrics: [ overlap_m ]               # optional; default every limited metric
 //     set: [ "controller.threshold_m=5" ]  # optional, as --set
 //     budget: 60                           # optional, as the command line's defaults
