@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "harness/plot/gnuplot_panel.h"
 #include "rig/text/number_text.h"
@@ -270,17 +272,73 @@ Panel parameter_panel(const FalsifyRecord& record, std::size_t key) {
     return panel;
 }
 
+// Where a pair's plane breaks a limit, as far as the points say: each cell
+// of a grid over the pair's ranges takes the verdict most of its three
+// nearest judged points have (distances in each axis as a fraction of its
+// range). The search's other parameters are projected away, so this is the
+// points' own verdicts spread over the plane, not a margin interpolated
+// between them: inverse-distance interpolation of the margins drew rings
+// around single points and lines where no boundary was (margins from +0.2 to
+// -3.7, the third parameter varying underneath).
+struct JudgedPoint {
+    double x = 0.0;
+    double y = 0.0;
+    bool falsifying = false;
+};
+
+// A gnuplot rgbimage block: x y r g b per cell, scan lines apart.
+std::string verdict_regions(const std::vector<JudgedPoint>& judged, const VaryRange& x, const VaryRange& y) {
+    constexpr int kCells = 60;
+    constexpr std::size_t kNearest = 3;
+    const auto axis_low = [](const VaryRange& range) { return range.is_choice() ? -0.5 : range.low; };
+    const auto axis_high = [](const VaryRange& range) {
+        return range.is_choice() ? static_cast<double>(range.choices.size()) - 0.5 : range.high;
+    };
+    const double x_low = axis_low(x);
+    const double x_width = axis_high(x) - x_low;
+    const double y_low = axis_low(y);
+    const double y_width = axis_high(y) - y_low;
+    std::string block = "$regions << EOD\n";
+    std::vector<std::pair<double, bool>> nearest;
+    for (int row = 0; row < kCells; ++row) {
+        const double at_y = y_low + (row + 0.5) * y_width / kCells;
+        for (int column = 0; column < kCells; ++column) {
+            const double at_x = x_low + (column + 0.5) * x_width / kCells;
+            nearest.clear();
+            for (const JudgedPoint& point : judged) {
+                const double dx = (point.x - at_x) / x_width;
+                const double dy = (point.y - at_y) / y_width;
+                nearest.emplace_back(dx * dx + dy * dy, point.falsifying);
+            }
+            const std::size_t count = std::min(kNearest, nearest.size());
+            std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(count), nearest.end());
+            const auto breaking = std::count_if(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(count),
+                                                [](const auto& near) { return near.second; });
+            const bool breaks = 2 * static_cast<std::size_t>(breaking) > count;
+            block += exact_number(at_x) + " " + exact_number(at_y) + (breaks ? " 253 224 221\n" : " 255 255 255\n");
+        }
+        block += "\n";
+    }
+    return block + "EOD\n";
+}
+
 // The margin over a pair of parameters: each point coloured by its margin,
-// the falsifying ones marked, and the limit's contour (margin 0) of the
-// margins interpolated on a grid (gnuplot's dgrid3d, inverse distance).
+// the falsifying ones marked, and the plane shaded where the nearest points
+// break a limit (verdict_regions).
 Panel pair_panel(const FalsifyRecord& record, std::size_t first, std::size_t second) {
     const VaryRange& x = record.search_case.ranges[first];
     const VaryRange& y = record.search_case.ranges[second];
     std::vector<std::vector<double>> points;
     std::vector<std::vector<double>> falsifying;
+    std::vector<JudgedPoint> judged;
     double largest = 0.0;
     for (const SearchedPoint& point : record.outcome.points) {
-        if (counts_as_falsifying(point.margin)) falsifying.push_back({point.values[first], point.values[second]});
+        const bool breaks = counts_as_falsifying(point.margin);
+        if (breaks) falsifying.push_back({point.values[first], point.values[second]});
+        // An invalid point says nothing of the controller; a broken one breaks.
+        if (point.margin.invalid.empty() && (point.margin.margin || breaks)) {
+            judged.push_back({point.values[first], point.values[second], breaks});
+        }
         if (!point.margin.margin) continue;
         points.push_back({point.values[first], point.values[second], *point.margin.margin});
         largest = std::max(largest, std::fabs(*point.margin.margin));
@@ -288,30 +346,24 @@ Panel pair_panel(const FalsifyRecord& record, std::size_t first, std::size_t sec
     if (largest == 0.0) largest = 1.0;
     Panel panel;
     panel.what = "margin over " + x.key + " and " + y.key;
-    panel.caption = panel.what;
+    panel.caption = panel.what + "; shaded where the three nearest points (in these two parameters) mostly break a limit";
     panel.height = 480;
     std::string& script = panel.script;
     script += data_block("points", points) + data_block("falsifying", falsifying);
+    const bool shaded = !judged.empty();
+    if (shaded) script += verdict_regions(judged, x, y);
     script += "set title " + gnuplot_string("margin over " + x.key + " and " + y.key) + "\n";
     script += "set xlabel " + gnuplot_string(x.key) + "\nset ylabel " + gnuplot_string(y.key) + "\n";
     script += axis_script("x", x) + axis_script("y", y);
-    // Four points at least, or the grid is an artefact of too few; and no
-    // contour across choices, between which nothing lies to interpolate.
-    const bool contour = points.size() >= 4 && !x.is_choice() && !y.is_choice();
-    if (contour) {
-        script += "set dgrid3d 40,40 qnorm 2\nset contour base\nset cntrparam levels discrete 0\nunset surface\n"
-                  "set table $contour\nsplot $points using 1:2:3 with lines notitle\nunset table\n"
-                  "unset dgrid3d\nunset contour\nset surface\n";
-    }
     script += "set palette defined (-1 '#d62728', 0 '#f7f7f7', 1 '#1f77b4')\n";
     script += "set cbrange [" + exact_number(-largest) + ":" + exact_number(largest) + "]\nset cblabel 'margin'\n";
-    script += "set grid\nset key outside bottom center horizontal\n";
-    // Each point outlined: a margin near 0 is near white in the palette.
-    script += "plot $points using 1:2:3 with points pt 7 ps 1.1 lc palette title 'points (colour: margin)', "
-              "$points using 1:2 with points pt 6 ps 1.1 lc rgb '#555555' notitle";
-    if (contour) {
-        script += ", $contour using 1:2 with lines lw 2 lc " + rgb(kLimitColor) + " title 'margin 0 (interpolated)'";
+    script += "set grid front\nset key outside bottom center horizontal\nplot ";
+    if (shaded) {
+        script += "$regions using 1:2:3:4:5 with rgbimage title 'shaded: the nearest points mostly break a limit', ";
     }
+    // Each point outlined: a margin near 0 is near white in the palette.
+    script += "$points using 1:2:3 with points pt 7 ps 1.1 lc palette title 'points (colour: margin)', "
+              "$points using 1:2 with points pt 6 ps 1.1 lc rgb '#555555' notitle";
     script += ", $falsifying using 1:2 with points pt 2 ps 1.6 lw 2 lc rgb '#000000' title 'breaks a limit'\n";
     return panel;
 }
