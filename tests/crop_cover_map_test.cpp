@@ -3,11 +3,16 @@
 // patches, and cover_fraction against a direct count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
+#include "emulators/field2d/counter_hash.h"
 #include "emulators/field2d/crop_cover_map.h"
+#include "emulators/field2d/leaf_raster.h"
 
 namespace {
 
@@ -121,6 +126,119 @@ TEST(CropCoverMap, CoverFractionIsTheShareOfPlantCellsInside) {
     }
     ASSERT_NEAR(static_cast<double>(inside), 240000.0, 1000.0);  // 0.24 m^2 at 1 mm
     EXPECT_NEAR(map.cover_fraction(quad), static_cast<double>(plant) / static_cast<double>(inside), 0.002);
+}
+
+// The crossing-number rule for one point, written out: inside when an odd
+// number of edges cross its row right of it.
+bool inside_by_crossings(const std::array<Vec2, 4>& q, double x, double y) {
+    bool inside = false;
+    for (std::size_t i = 0, j = 3; i < 4; j = i++) {
+        const Vec2 a = q[i];
+        const Vec2 b = q[j];
+        if ((a.north_m > y) != (b.north_m > y)) {
+            const double x_at = a.east_m + (y - a.north_m) * (b.east_m - a.east_m) / (b.north_m - a.north_m);
+            if (x < x_at) inside = !inside;
+        }
+    }
+    return inside;
+}
+
+TEST(CropCoverMap, CoverFractionCountsExactlyTheCellsWhoseCentresAreInside) {
+    // cover_fraction counts runs of cells per row; here every cell centre of
+    // the box around each quadrilateral is tested on its own, and the two
+    // counts must agree to the cell: turned rectangles, a kite, a concave
+    // quadrilateral, one straddling tiles at negative coordinates.
+    const CropCoverMap map(CropCoverParams{}, 21);
+    const std::vector<std::array<Vec2, 4>> quads{
+        nozzle_roi_ground(Vec2{1.3, 2.1}, 17.0, 0.25),
+        nozzle_roi_ground(Vec2{-0.7, -0.4}, 200.0, -0.5),
+        nozzle_roi_ground(Vec2{0.0, 0.0}, 90.0, 0.0),
+        {Vec2{0.0, 0.0}, Vec2{0.3, -0.1}, Vec2{0.45, 0.2}, Vec2{0.1, 0.35}},
+        {Vec2{-0.3, -0.2}, Vec2{0.2, -0.15}, Vec2{-0.05, 0.0}, Vec2{0.15, 0.3}},  // concave at its third corner
+    };
+    for (const auto& quad : quads) {
+        double e_min = 1e9, e_max = -1e9, n_min = 1e9, n_max = -1e9;
+        for (const Vec2 c : quad) {
+            e_min = std::min(e_min, c.east_m);
+            e_max = std::max(e_max, c.east_m);
+            n_min = std::min(n_min, c.north_m);
+            n_max = std::max(n_max, c.north_m);
+        }
+        long inside = 0;
+        long plant = 0;
+        for (auto j = static_cast<std::int64_t>(std::floor(n_min / 0.001)); j <= static_cast<std::int64_t>(std::floor(n_max / 0.001)); ++j) {
+            for (auto i = static_cast<std::int64_t>(std::floor(e_min / 0.001)); i <= static_cast<std::int64_t>(std::floor(e_max / 0.001)); ++i) {
+                const double x = (static_cast<double>(i) + 0.5) * 0.001;
+                const double y = (static_cast<double>(j) + 0.5) * 0.001;
+                if (!inside_by_crossings(quad, x, y)) continue;
+                ++inside;
+                if (map.is_plant(Vec2{x, y})) ++plant;
+            }
+        }
+        ASSERT_GT(inside, 10000);
+        EXPECT_EQ(map.cover_fraction(quad), static_cast<double>(plant) / static_cast<double>(inside))
+            << "quadrilateral from (" << quad[0].east_m << ", " << quad[0].north_m << ")";
+    }
+}
+
+// Squared distance from p to the segment a-b, the leaf's definition written out.
+double distance_sq_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+    const Vec2 d = b - a;
+    const double length_sq = dot(d, d);
+    const double t = length_sq > 0.0 ? std::clamp(dot(p - a, d) / length_sq, 0.0, 1.0) : 0.0;
+    const Vec2 e = p - (a + t * d);
+    return dot(e, e);
+}
+
+TEST(LeafRaster, DrawLeafMarksExactlyTheCellsWhoseCentresLieOnTheLeaf) {
+    // draw_leaf fills each row's run at once and tests only its ends; every
+    // cell of the block is tested here on its own. Random leaves (some off
+    // the block's edges, some flat along an axis, a dot of no length).
+    constexpr int kSide = 96;
+    HashStream random(hash_key(5, 6, 7));
+    std::vector<LeafStrip> leaves;
+    for (int k = 0; k < 400; ++k) {
+        const double bx = -0.02 + 0.136 * random.uniform01();
+        const double by = -0.02 + 0.136 * random.uniform01();
+        const double azimuth = 6.283185307179586 * random.uniform01();
+        const double length = 0.12 * random.uniform01();
+        leaves.push_back({bx, by, bx + length * std::cos(azimuth), by + length * std::sin(azimuth), 0.0005 + 0.006 * random.uniform01()});
+    }
+    leaves.push_back({0.0105, 0.02, 0.0705, 0.02, 0.004});    // along a row, its edges on cell centres
+    leaves.push_back({0.03, 0.0005, 0.03, 0.09, 0.0035});     // along a column
+    leaves.push_back({0.05, 0.05, 0.05, 0.05, 0.003});        // no length: a disc
+    int leaf_cells = 0;
+    for (const LeafStrip& leaf : leaves) {
+        std::vector<std::uint8_t> cells(kSide * kSide, 0);
+        draw_leaf(cells.data(), kSide, leaf);
+        for (int j = 0; j < kSide; ++j) {
+            for (int i = 0; i < kSide; ++i) {
+                const Vec2 centre{(i + 0.5) * 0.001, (j + 0.5) * 0.001};
+                const bool on = distance_sq_to_segment(centre, Vec2{leaf.base_x_m, leaf.base_y_m}, Vec2{leaf.tip_x_m, leaf.tip_y_m}) <=
+                                leaf.half_width_m * leaf.half_width_m;
+                ASSERT_EQ(cells[static_cast<std::size_t>(j * kSide + i)] != 0, on) << "cell (" << i << ", " << j << ")";
+                ASSERT_EQ(cell_on_leaf(leaf, i, j), on);
+                leaf_cells += on ? 1 : 0;
+            }
+        }
+    }
+    EXPECT_GT(leaf_cells, 50000);  // the leaves do cover cells
+}
+
+TEST(LeafRaster, FirstCentrePastSplitsARowAsCellByCellComparison) {
+    for (const double x : {-0.0125, -0.0005, 0.0, 0.0005, 0.00049999, 0.0123456, 0.0995, 0.2}) {
+        for (const CentrePast rule : {CentrePast::at_or_right, CentrePast::strictly_right}) {
+            std::int64_t expected = 100;
+            for (std::int64_t i = -20; i < 100; ++i) {
+                const bool past = rule == CentrePast::strictly_right ? cell_centre_m(i) > x : cell_centre_m(i) >= x;
+                if (past) {
+                    expected = i;
+                    break;
+                }
+            }
+            EXPECT_EQ(first_centre_past(x, -20, 100, rule), expected) << x;
+        }
+    }
 }
 
 TEST(NozzleRoiGround, Sec21RectangleAheadOfTheNozzle) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "emulators/field2d/counter_hash.h"
+#include "emulators/field2d/leaf_raster.h"
 #include "rig/camera/parameter_check.h"
 
 namespace rig::field2d {
@@ -25,7 +26,7 @@ constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
 constexpr std::size_t kMaxCachedTiles = 1024;
 // Plants are drawn per row cell of this length along the row.
 constexpr double kRowCellM = 0.25;
-// rasterise()'s margin between a leaf's surely-inside and surely-outside cells.
+// A plant reaching the tile by less than this draws nothing on it (rounding is some 1e-18 m here).
 constexpr double kSureM = 1e-9;
 
 // Poisson by inversion of its CDF (mean at most 250 here, so exp(-mean) stays a normal double).
@@ -67,76 +68,6 @@ void require(bool ok, const char* field, double value, const char* bounds) {
 }
 using rig::camera::finite_within;
 
-// Squared distance from p to the segment a-b.
-double segment_distance_sq(double px, double py, double ax, double ay, double bx, double by) {
-    const double dx = bx - ax;
-    const double dy = by - ay;
-    const double length_sq = dx * dx + dy * dy;
-    double t = length_sq > 0.0 ? ((px - ax) * dx + (py - ay) * dy) / length_sq : 0.0;
-    t = std::clamp(t, 0.0, 1.0);
-    const double ex = px - (ax + t * dx);
-    const double ey = py - (ay + t * dy);
-    return ex * ex + ey * ey;
-}
-
-// The x extent, at height y, of the points within `radius` of the segment a-b
-// (a capsule: convex, so its slice is one interval, the union of the slices of
-// its two end discs and its middle rectangle). Empty (low > high) if none.
-struct Span {
-    double low = 1e300;
-    double high = -1e300;
-    void cover(double from, double to) {
-        if (from > to) return;
-        low = std::min(low, from);
-        high = std::max(high, to);
-    }
-};
-
-// A leaf: the points within some radius of the segment a-b.
-struct Capsule {
-    double ax, ay, bx, by;
-    double ux, uy, length;  // unit vector a -> b and the segment's length
-
-    Capsule(double from_x, double from_y, double to_x, double to_y)
-        : ax(from_x), ay(from_y), bx(to_x), by(to_y), length(std::hypot(to_x - from_x, to_y - from_y)) {
-        ux = length > 0.0 ? (bx - ax) / length : 0.0;
-        uy = length > 0.0 ? (by - ay) / length : 0.0;
-    }
-
-    // The x extent at height y of the points within `radius` (a capsule is
-    // convex, so its slice is one interval: the union of the slices of its
-    // two end discs and its middle rectangle). Empty (low > high) if none.
-    Span slice(double y, double radius) const {
-        Span span;
-        for (const auto& [cx, cy] : {std::pair{ax, ay}, std::pair{bx, by}}) {
-            const double dy = y - cy;
-            if (std::abs(dy) <= radius) {
-                const double half = std::sqrt(radius * radius - dy * dy);
-                span.cover(cx - half, cx + half);
-            }
-        }
-        if (length <= 0.0) return span;
-        // The rectangle: 0 <= (p - a).u <= length and |(p - a).n| <= radius,
-        // n square to u, each linear in x at this y.
-        double low = -1e300;
-        double high = 1e300;
-        auto within = [&](double slope, double offset, double lo, double hi) {
-            if (std::abs(slope) < 1e-12) {
-                if (offset < lo || offset > hi) high = -1e300;
-                return;
-            }
-            const double x1 = (lo - offset) / slope;
-            const double x2 = (hi - offset) / slope;
-            low = std::max(low, std::min(x1, x2));
-            high = std::min(high, std::max(x1, x2));
-        };
-        within(ux, -ax * ux + (y - ay) * uy, 0.0, length);
-        within(-uy, ax * uy + (y - ay) * ux, -radius, radius);
-        span.cover(low, high);
-        return span;
-    }
-};
-
 bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
     const double d1 = cross(b - a, c - a);
     const double d2 = cross(b - a, d - a);
@@ -145,19 +76,20 @@ bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
     return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
 }
 
-// Crossing-number test (a point on an edge may fall either way; only cell
-// centres are tested, and a 1 mm cell on the edge of a 0.24 m^2 ROI is noise).
-bool inside_quad(const std::array<Vec2, 4>& q, double x, double y) {
-    bool inside = false;
-    for (std::size_t i = 0, j = 3; i < 4; j = i++) {
-        const Vec2 a = q[i];
-        const Vec2 b = q[j];
-        if ((a.north_m > y) != (b.north_m > y)) {
-            const double x_at = a.east_m + (y - a.north_m) * (b.east_m - a.east_m) / (b.north_m - a.north_m);
-            if (x < x_at) inside = !inside;
-        }
-    }
-    return inside;
+// The plant cells among 8 cells (each kPlantCell or 0): one bit of each byte
+// summed into the top byte by a multiply (at most 8, no carries between bytes).
+int plant_cells_in_8(const std::uint8_t* cells) {
+    std::uint64_t word = 0;
+    std::memcpy(&word, cells, sizeof word);
+    return static_cast<int>(((word & 0x0101010101010101ULL) * 0x0101010101010101ULL) >> 56);
+}
+
+int plant_cells_in(const std::uint8_t* cells, std::size_t count) {
+    int plant = 0;
+    std::size_t i = 0;
+    for (; i + 8 <= count; i += 8) plant += plant_cells_in_8(cells + i);
+    for (; i < count; ++i) plant += cells[i] != 0 ? 1 : 0;
+    return plant;
 }
 
 }  // namespace
@@ -285,48 +217,34 @@ void CropCoverMap::rasterise(Tile& tile, std::int64_t tile_east, std::int64_t ti
                 const int leaves = p.leaves_min + std::min(p.leaves_max - p.leaves_min,
                                                            static_cast<int>(stream.uniform01() * (p.leaves_max - p.leaves_min + 1)));
                 const Vec2 base = along * along_axis + across * across_axis;
-                double rate = 0.0;
-                switch (cover_class_at(base)) {
-                    case CoverClass::bare: rate = 0.0; break;
-                    case CoverClass::sparse: rate = p.sparse_plants_per_m; break;
-                    case CoverClass::normal: rate = p.normal_plants_per_m; break;
+                const double bx = base.east_m - east0;
+                const double by = base.north_m - north0;
+                // A plant whose longest leaf cannot reach the tile draws nothing
+                // on it: its class and leaves are not worked out (their numbers
+                // are still drawn, above and below, so the stream stays in step).
+                const double plant_reach = height * p.leaf_length_per_height_max + half_width + kSureM;
+                const bool near_tile = bx + plant_reach >= 0.0 && bx - plant_reach <= kTileM && by + plant_reach >= 0.0 &&
+                                       by - plant_reach <= kTileM;
+                bool kept = false;
+                if (near_tile) {
+                    double rate = 0.0;
+                    switch (cover_class_at(base)) {
+                        case CoverClass::bare: rate = 0.0; break;
+                        case CoverClass::sparse: rate = p.sparse_plants_per_m; break;
+                        case CoverClass::normal: rate = p.normal_plants_per_m; break;
+                    }
+                    kept = densest > 0.0 && keep < rate / densest;
                 }
-                const bool kept = densest > 0.0 && keep < rate / densest;
                 for (int leaf = 0; leaf < leaves; ++leaf) {
                     const double azimuth = 2.0 * std::numbers::pi * stream.uniform01();
                     const double length = height * (p.leaf_length_per_height_min +
                                                     stream.uniform01() * (p.leaf_length_per_height_max - p.leaf_length_per_height_min));
                     if (!kept) continue;
-                    const double bx = base.east_m - east0;
-                    const double by = base.north_m - north0;
                     const double tx = bx + length * std::cos(azimuth);
                     const double ty = by + length * std::sin(azimuth);
                     if (std::max(bx, tx) + half_width < 0.0 || std::min(bx, tx) - half_width > kTileM) continue;  // beside the tile
-                    const Capsule leaf_shape(bx, by, tx, ty);
-                    const int j_first = std::max(0, static_cast<int>(std::floor((std::min(by, ty) - half_width) / kCellM)));
-                    const int j_last = std::min(kTileCells - 1, static_cast<int>(std::floor((std::max(by, ty) + half_width) / kCellM)));
-                    for (int j = j_first; j <= j_last; ++j) {
-                        const double cy = (j + 0.5) * kCellM;
-                        // A cell is plant when its centre is within half_width of
-                        // the leaf's mid-line. Centres within the slice narrowed by
-                        // kSureM are surely so and centres outside the one widened
-                        // by it surely not (rounding is some 1e-18 m here); only
-                        // those between take the exact test.
-                        const Span maybe = leaf_shape.slice(cy, half_width + kSureM);
-                        if (maybe.low > maybe.high || maybe.high < 0.0 || maybe.low > kTileM) continue;
-                        const Span sure = leaf_shape.slice(cy, half_width - kSureM);
-                        const int i_first = std::max(0, static_cast<int>(std::floor(maybe.low / kCellM - 0.5)));
-                        const int i_last = std::min(kTileCells - 1, static_cast<int>(std::ceil(maybe.high / kCellM - 0.5)));
-                        std::uint8_t* tile_row = tile.plant.data() + static_cast<std::size_t>(j) * kTileCells;
-                        for (int i = i_first; i <= i_last; ++i) {
-                            const double cx = (i + 0.5) * kCellM;
-                            if (cx > sure.low && cx < sure.high) {
-                                tile_row[i] = kPlantCell;
-                            } else if (segment_distance_sq(cx, cy, bx, by, tx, ty) <= half_width * half_width) {
-                                tile_row[i] = kPlantCell;
-                            }
-                        }
-                    }
+                    if (std::max(by, ty) + half_width < 0.0 || std::min(by, ty) - half_width > kTileM) continue;  // above or below it
+                    draw_leaf(tile.plant.data(), kTileCells, LeafStrip{bx, by, tx, ty, half_width});
                 }
             }
         }
@@ -351,23 +269,62 @@ double CropCoverMap::cover_fraction(const std::array<Vec2, 4>& corners) const {
     if ((east_max - east_min) * (north_max - north_min) > 100.0) {
         throw std::invalid_argument("crop cover_fraction: the quadrilateral spans more than 100 m^2 (an ROI is 0.24 m^2)");
     }
+    if (!(std::abs(east_min) < 1e6 && std::abs(east_max) < 1e6 && std::abs(north_min) < 1e6 && std::abs(north_max) < 1e6)) {
+        throw std::invalid_argument("crop cover_fraction: the quadrilateral reaches 1000 km or more from the origin");
+    }
     const auto i_first = static_cast<std::int64_t>(std::floor(east_min / kCellM));
     const auto i_last = static_cast<std::int64_t>(std::floor(east_max / kCellM));
     const auto j_first = static_cast<std::int64_t>(std::floor(north_min / kCellM));
     const auto j_last = static_cast<std::int64_t>(std::floor(north_max / kCellM));
+    // A cell is inside when its centre is, by the crossing-number rule: an
+    // odd number of the quadrilateral's edges cross its row right of it (a
+    // centre on an edge may fall either way; a 1 mm cell on the edge of a
+    // 0.24 m^2 ROI is noise). Along a row the centres only grow, so each
+    // crossing splits the row at one cell, found by the same comparison a
+    // cell-by-cell test makes; the cells between splits are counted in runs.
     std::int64_t inside = 0;
     std::int64_t plant = 0;
     for (std::int64_t j = j_first; j <= j_last; ++j) {
         const double y = (static_cast<double>(j) + 0.5) * kCellM;
-        for (std::int64_t i = i_first; i <= i_last; ++i) {
-            const double x = (static_cast<double>(i) + 0.5) * kCellM;
-            if (!inside_quad(corners, x, y)) continue;
-            ++inside;
-            if (is_plant(Vec2{x, y})) ++plant;
+        std::array<std::int64_t, 4> splits{};
+        std::size_t crossings = 0;
+        for (std::size_t i = 0, k = 3; i < 4; k = i++) {
+            const Vec2 a = corners[i];
+            const Vec2 b = corners[k];
+            if ((a.north_m > y) != (b.north_m > y)) {
+                const double x_at = a.east_m + (y - a.north_m) * (b.east_m - a.east_m) / (b.north_m - a.north_m);
+                splits[crossings++] = first_centre_past(x_at, i_first, i_last + 1, CentrePast::at_or_right);
+            }
+        }
+        for (std::size_t k = 1; k < crossings; ++k) {  // into order (at most four)
+            for (std::size_t m = k; m > 0 && splits[m - 1] > splits[m]; --m) std::swap(splits[m - 1], splits[m]);
+        }
+        // Cells from splits[k - 1] to splits[k] have crossings - k crossings right of them.
+        for (std::size_t k = 0; k <= crossings; ++k) {
+            if ((crossings - k) % 2 == 0) continue;
+            const std::int64_t from = k == 0 ? i_first : splits[k - 1];
+            const std::int64_t to = k == crossings ? i_last + 1 : splits[k];
+            if (to <= from) continue;
+            inside += to - from;
+            plant += plant_cells_in_row(j, from, to);
         }
     }
     if (inside == 0) throw std::invalid_argument("crop cover_fraction: the quadrilateral holds no 1 mm cell centre");
     return static_cast<double>(plant) / static_cast<double>(inside);
+}
+
+std::int64_t CropCoverMap::plant_cells_in_row(std::int64_t north_cell, std::int64_t east_first, std::int64_t east_end) const {
+    const std::int64_t tile_north = north_cell >> kTileShift;
+    const auto j = static_cast<std::size_t>(north_cell - tile_north * kTileCells);
+    std::int64_t plant = 0;
+    for (std::int64_t tile_east = east_first >> kTileShift; tile_east * kTileCells < east_end; ++tile_east) {
+        const std::int64_t from = std::max(east_first, tile_east * kTileCells);
+        const std::int64_t to = std::min(east_end, (tile_east + 1) * kTileCells);
+        const Tile& t = tile(tile_east, tile_north);
+        plant += plant_cells_in(t.plant.data() + j * kTileCells + static_cast<std::size_t>(from - tile_east * kTileCells),
+                                static_cast<std::size_t>(to - from));
+    }
+    return plant;
 }
 
 void CropCoverMap::copy_cells(std::int64_t east_cell, std::int64_t north_cell, int cols, int rows, std::uint8_t* out,

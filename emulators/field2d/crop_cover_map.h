@@ -121,6 +121,8 @@ private:
     struct Tile;
     const Tile& tile(std::int64_t tile_east, std::int64_t tile_north) const;
     void rasterise(Tile& tile, std::int64_t tile_east, std::int64_t tile_north) const;
+    // The plant cells of row north_cell from east_first up to (not including) east_end.
+    std::int64_t plant_cells_in_row(std::int64_t north_cell, std::int64_t east_first, std::int64_t east_end) const;
 
     CropCoverParams params_;
     std::uint64_t seed_;

@@ -1,12 +1,15 @@
 #include "emulators/vision/camera_emulator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "emulators/field2d/counter_hash.h"
@@ -109,6 +112,96 @@ LitColours lit_colours(const CameraEmulatorParams& params) {
                       gain * params.lighting_cast.blue * params.faults.colour_cast.blue};
 }
 
+
+// The colour table's entry for pixels whose rays miss the ground.
+constexpr int kSkyEntry = 256;
+
+// The block of the crop truth a frame's samples read, from the view's first cell.
+struct CoverView {
+    const std::uint8_t* cells = nullptr;
+    std::size_t step = 0;  // cells from one row to the next
+    int cols = 0;
+    int rows = 0;
+};
+
+// One row of one-sample pixels: each pixel centre's undistorted point
+// (x, y) through the homography h (row-major) to the view's cells, and the
+// cell it falls in, 0 outside the view. The arithmetic is OpenCV's
+// fixed-point remap's on single-precision maps: the point in single
+// precision, ((h0 x + h1 y) + h2) / depth with the depth held below the
+// horizon, clamped to +-kFarCells, rounded to the nearest cell (ties to
+// even, as cvRound), then the nearest cell read. Four pixels at a time.
+void sample_row_nearest(const float* xs, const float* ys, int width, const float h[9], const CoverView& view, std::uint8_t* out) {
+    const cv::v_float32x4 h00 = cv::v_setall_f32(h[0]), h01 = cv::v_setall_f32(h[1]), h02 = cv::v_setall_f32(h[2]);
+    const cv::v_float32x4 h10 = cv::v_setall_f32(h[3]), h11 = cv::v_setall_f32(h[4]), h12 = cv::v_setall_f32(h[5]);
+    const cv::v_float32x4 h20 = cv::v_setall_f32(h[6]), h21 = cv::v_setall_f32(h[7]), h22 = cv::v_setall_f32(h[8]);
+    const cv::v_float32x4 horizon = cv::v_setall_f32(-1e-6F);
+    const cv::v_float32x4 far_low = cv::v_setall_f32(-kFarCells), far_high = cv::v_setall_f32(kFarCells);
+    auto read = [&view](int col, int row) -> std::uint8_t {
+        if (static_cast<unsigned>(col) >= static_cast<unsigned>(view.cols) || static_cast<unsigned>(row) >= static_cast<unsigned>(view.rows)) return 0;
+        return view.cells[static_cast<std::size_t>(row) * view.step + static_cast<std::size_t>(col)];
+    };
+    int u = 0;
+    for (; u + 4 <= width; u += 4) {
+        const cv::v_float32x4 x = cv::v_load(xs + u);
+        const cv::v_float32x4 y = cv::v_load(ys + u);
+        const cv::v_float32x4 depth = cv::v_min(h20 * x + h21 * y + h22, horizon);
+        const cv::v_int32x4 col = cv::v_round(cv::v_min(cv::v_max((h00 * x + h01 * y + h02) / depth, far_low), far_high));
+        const cv::v_int32x4 row = cv::v_round(cv::v_min(cv::v_max((h10 * x + h11 * y + h12) / depth, far_low), far_high));
+        int cols[4];
+        int rows[4];
+        cv::v_store(cols, col);
+        cv::v_store(rows, row);
+        for (int k = 0; k < 4; ++k) out[u + k] = read(cols[k], rows[k]);
+    }
+    for (; u < width; ++u) {
+        const float depth = std::min(h[6] * xs[u] + h[7] * ys[u] + h[8], -1e-6F);
+        const float col = std::min(std::max((h[0] * xs[u] + h[1] * ys[u] + h[2]) / depth, -kFarCells), kFarCells);
+        const float row = std::min(std::max((h[3] * xs[u] + h[4] * ys[u] + h[5]) / depth, -kFarCells), kFarCells);
+        out[u] = read(cvRound(col), cvRound(row));
+    }
+}
+
+// One row of the frame from its pixels' cover (0 soil .. 255 plant): each
+// pixel's colour from the table (sky where `sky` is set), plus its noise (if
+// any), both in 1/64 DN and summed saturating at 16 bits, then rounded to a
+// DN (ties to even) and clipped to 0-255. `lit` holds 3 x width + 1 values.
+void colour_row(const std::uint8_t* cover, const std::uint8_t* sky, const std::int16_t* table, const std::int16_t* noise, int width,
+                std::int16_t* lit, std::uint8_t* out) {
+    for (int u = 0; u < width; ++u) {
+        const int entry = sky != nullptr && sky[u] != 0 ? kSkyEntry : cover[u];
+        std::memcpy(lit + 3 * u, table + 4 * entry, 4 * sizeof(std::int16_t));  // the fourth is overwritten by the next pixel
+    }
+    const int values = 3 * width;
+    const cv::v_int16x8 low_bits = cv::v_setall_s16(63);
+    const cv::v_int16x8 half = cv::v_setall_s16(32);
+    const cv::v_int16x8 one = cv::v_setall_s16(1);
+    auto to_dn = [&](cv::v_int16x8 sub) {
+        // sub / 64 rounded half to even: the floor, plus one above half or at half with an odd floor.
+        const cv::v_int16x8 whole = sub >> 6;
+        const cv::v_int16x8 rest = sub & low_bits;
+        const cv::v_int16x8 up = (rest > half) | ((rest == half) & ((whole & one) == one));
+        return whole - up;  // up is -1 (all bits) where it rounds up
+    };
+    int i = 0;
+    for (; i + 16 <= values; i += 16) {
+        cv::v_int16x8 a = cv::v_load(lit + i);
+        cv::v_int16x8 b = cv::v_load(lit + i + 8);
+        if (noise != nullptr) {
+            a = a + cv::v_load(noise + i);  // saturating, as cv::add on 16-bit values
+            b = b + cv::v_load(noise + i + 8);
+        }
+        cv::v_store(out + i, cv::v_pack_u(to_dn(a), to_dn(b)));  // clipped to 0-255
+    }
+    for (; i < values; ++i) {
+        const int sum = lit[i] + (noise != nullptr ? noise[i] : 0);
+        const int sub = std::clamp(sum, -32768, 32767);
+        int dn = sub >> 6;
+        const int rest = sub & 63;
+        if (rest > 32 || (rest == 32 && (dn & 1) != 0)) ++dn;
+        out[i] = static_cast<std::uint8_t>(std::clamp(dn, 0, 255));
+    }
+}
 }  // namespace
 
 void validate(const CameraEmulatorParams& p, const std::string& where) {
@@ -329,42 +422,77 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     const Eigen::Matrix3d to_view = normalized_to_ground_cells(pose, view_east, view_north);
     const Eigen::Matrix3f h = to_view.cast<float>();
 
-    // Colour by cover (0 soil .. 255 plant) under this camera's light.
+    // Colour by cover (0 soil .. 255 plant) under this camera's light, and
+    // sky (entry kSkyEntry), four 1/64 DN values an entry (the fourth unused).
     const LitColours light = lit_colours(params_);
-    cv::Mat cover_to_rgb(1, 256, CV_16SC3);
+    std::array<std::int16_t, 4 * (kSkyEntry + 1)> colour_table{};
     for (int cover = 0; cover < 256; ++cover) {
         const double plant_share = cover / 255.0;
         const Rgb soil = params_.soil_rgb;
         const Rgb plant = params_.plant_rgb;
-        cover_to_rgb.at<cv::Vec3s>(0, cover) =
-            cv::Vec3s(sub_dn((soil.r + plant_share * (plant.r - soil.r)) * light.red_gain),
-                      sub_dn((soil.g + plant_share * (plant.g - soil.g)) * light.green_gain),
-                      sub_dn((soil.b + plant_share * (plant.b - soil.b)) * light.blue_gain));
+        std::int16_t* entry = colour_table.data() + 4 * cover;
+        entry[0] = sub_dn((soil.r + plant_share * (plant.r - soil.r)) * light.red_gain);
+        entry[1] = sub_dn((soil.g + plant_share * (plant.g - soil.g)) * light.green_gain);
+        entry[2] = sub_dn((soil.b + plant_share * (plant.b - soil.b)) * light.blue_gain);
     }
-    const cv::Scalar sky(sub_dn(params_.sky_rgb.r * light.red_gain), sub_dn(params_.sky_rgb.g * light.green_gain),
-                         sub_dn(params_.sky_rgb.b * light.blue_gain));
+    std::int16_t* sky_entry = colour_table.data() + 4 * kSkyEntry;
+    sky_entry[0] = sub_dn(params_.sky_rgb.r * light.red_gain);
+    sky_entry[1] = sub_dn(params_.sky_rgb.g * light.green_gain);
+    sky_entry[2] = sub_dn(params_.sky_rgb.b * light.blue_gain);
 
     // This frame's window into the noise table.
     const std::uint64_t frame_key = rig::field2d::hash_finalise(noise_key_ ^ rig::field2d::hash_finalise(frame_index));
     const int noise_u = static_cast<int>(frame_key % kNoiseShifts);
     const int noise_v = static_cast<int>((frame_key >> 32) % kNoiseShifts);
-    // Headers over this object's own tables, only read (OpenCV has no const Mat over const data).
-    const int table_width = width + kNoiseShifts - 1;
-    const int table_height = height + kNoiseShifts - 1;
-    cv::Mat noise;
-    if (!noise_.empty()) noise = cv::Mat(table_height, table_width, CV_16SC3, const_cast<std::int16_t*>(noise_.data()));
-    const cv::Mat sky_pixels(height, width, CV_8UC1, const_cast<std::uint8_t*>(sky_pixels_.data()));
-    // The maps count from the view's first cell: remap reads the window from there.
-    cv::Mat view;
+    const std::size_t noise_row_values = 3U * static_cast<std::size_t>(width + kNoiseShifts - 1);
+    // The maps count from the view's first cell: the samples read the window from there.
+    CoverView view;
+    cv::Mat view_mat;
     if (sees_ground) {
-        const cv::Mat window(window_.rows, window_.cols, CV_8UC1, window_.cells.data());
-        view = window(cv::Rect(static_cast<int>(static_cast<std::int64_t>(view_east) - window_.east_cell),
-                               static_cast<int>(static_cast<std::int64_t>(view_north) - window_.north_cell),
-                               static_cast<int>(window_.east_cell + window_.cols - static_cast<std::int64_t>(view_east)),
-                               static_cast<int>(window_.north_cell + window_.rows - static_cast<std::int64_t>(view_north))));
+        const auto first_col = static_cast<std::size_t>(static_cast<std::int64_t>(view_east) - window_.east_cell);
+        const auto first_row = static_cast<std::size_t>(static_cast<std::int64_t>(view_north) - window_.north_cell);
+        view.cells = window_.cells.data() + first_row * static_cast<std::size_t>(window_.cols) + first_col;
+        view.step = static_cast<std::size_t>(window_.cols);
+        view.cols = window_.cols - static_cast<int>(first_col);
+        view.rows = window_.rows - static_cast<int>(first_row);
+        // A header over the window, only read (OpenCV has no const Mat over const data).
+        view_mat = cv::Mat(view.rows, view.cols, CV_8UC1, const_cast<std::uint8_t*>(view.cells), view.step);
     }
-    const cv::Mat frame(height, width, CV_8UC3, image.bytes.data());
 
+    const int n = params_.samples_per_axis;
+    const auto pixels_per_row = static_cast<std::size_t>(width);
+    std::vector<std::uint8_t> cover_row(pixels_per_row);
+    std::vector<std::int16_t> lit_row(3 * pixels_per_row + 1);  // + 1: each pixel's colour is copied as four values
+    auto finish_row = [&](int v, const std::uint8_t* cover) {
+        const std::uint8_t* sky = any_sky_ ? sky_pixels_.data() + static_cast<std::size_t>(v) * pixels_per_row : nullptr;
+        const std::int16_t* noise =
+            noise_.empty() ? nullptr
+                           : noise_.data() + static_cast<std::size_t>(noise_v + v) * noise_row_values + 3U * static_cast<std::size_t>(noise_u);
+        colour_row(cover, sky, colour_table.data(), noise, width, lit_row.data(),
+                   image.bytes.data() + static_cast<std::size_t>(v) * 3U * pixels_per_row);
+    };
+    if (!sees_ground) {
+        std::fill(cover_row.begin(), cover_row.end(), std::uint8_t{0});
+        for (int v = 0; v < height; ++v) finish_row(v, cover_row.data());
+    } else if (n == 1) {
+        const float h_rows[9] = {h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2), h(2, 0), h(2, 1), h(2, 2)};
+        for (int v = 0; v < height; ++v) {
+            const std::size_t first = static_cast<std::size_t>(v) * pixels_per_row;
+            sample_row_nearest(centre_x_.data() + first, centre_y_.data() + first, width, h_rows, view, cover_row.data());
+            finish_row(v, cover_row.data());
+        }
+    } else {
+        render_cover_bands(h, view_mat, [&](int v0, const cv::Mat& cover) {
+            for (int r = 0; r < cover.rows; ++r) finish_row(v0 + r, cover.ptr<std::uint8_t>(r));
+        });
+    }
+    if (faults.blur_radius_px > 0) box_blur(image, faults.blur_radius_px);
+    return image;
+}
+void CameraEmulator::render_cover_bands(const Eigen::Matrix3f& h, const cv::Mat& view,
+                                        const std::function<void(int, const cv::Mat&)>& each_band) const {
+    const int width = camera_.width_px();
+    const int height = camera_.height_px();
     const int n = params_.samples_per_axis;
     const int band_rows = std::max(1, kBandSamples / (width * n * n));
     const std::size_t stride = static_cast<std::size_t>(width) + 1U;
@@ -373,8 +501,6 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     cv::Mat fixed_xy;
     cv::Mat samples;
     cv::Mat cover;
-    cv::Mat cover_rgb;
-    cv::Mat lit;
     Eigen::ArrayXf row_x(width + 1);
     Eigen::ArrayXf row_y(width + 1);
     Eigen::ArrayXf sample_x(width);
@@ -386,62 +512,37 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     using Strided = Eigen::Map<Eigen::ArrayXf, 0, Eigen::InnerStride<>>;
     for (int v0 = 0; v0 < height; v0 += band_rows) {
         const int rows = std::min(band_rows, height - v0);
-        if (sees_ground) {
-            const int sample_rows = rows * n;
-            for (int sample_row = 0; sample_row < sample_rows; ++sample_row) {
-                const auto v = static_cast<std::size_t>(v0 + sample_row / n);
-                if (n == 1) {
-                    const Row centre_x(centre_x_.data() + v * static_cast<std::size_t>(width), width);
-                    const Row centre_y(centre_y_.data() + v * static_cast<std::size_t>(width), width);
-                    depth = (h(2, 0) * centre_x + h(2, 1) * centre_y + h(2, 2)).min(-1e-6F);
-                    Eigen::Map<Eigen::ArrayXf>(map_x.ptr<float>(sample_row), width) =
-                        ((h(0, 0) * centre_x + h(0, 1) * centre_y + h(0, 2)) / depth).max(-kFarCells).min(kFarCells);
-                    Eigen::Map<Eigen::ArrayXf>(map_y.ptr<float>(sample_row), width) =
-                        ((h(1, 0) * centre_x + h(1, 1) * centre_y + h(1, 2)) / depth).max(-kFarCells).min(kFarCells);
-                    continue;
-                }
-                const float down = (static_cast<float>(sample_row % n) + 0.5F) / static_cast<float>(n);
-                const Row top_x(corner_x_.data() + v * stride, width + 1);
-                const Row top_y(corner_y_.data() + v * stride, width + 1);
-                const Row bottom_x(corner_x_.data() + (v + 1) * stride, width + 1);
-                const Row bottom_y(corner_y_.data() + (v + 1) * stride, width + 1);
-                row_x = top_x + down * (bottom_x - top_x);
-                row_y = top_y + down * (bottom_y - top_y);
-                for (int sample_col = 0; sample_col < n; ++sample_col) {
-                    const float across = (static_cast<float>(sample_col) + 0.5F) / static_cast<float>(n);
-                    sample_x = row_x.head(width) + across * (row_x.tail(width) - row_x.head(width));
-                    sample_y = row_y.head(width) + across * (row_y.tail(width) - row_y.head(width));
-                    // Below the horizon the depth is negative; a sky pixel's
-                    // samples are pushed far off the window (it is painted sky below).
-                    depth = (h(2, 0) * sample_x + h(2, 1) * sample_y + h(2, 2)).min(-1e-6F);
-                    seen_x = ((h(0, 0) * sample_x + h(0, 1) * sample_y + h(0, 2)) / depth).max(-kFarCells).min(kFarCells);
-                    seen_y = ((h(1, 0) * sample_x + h(1, 1) * sample_y + h(1, 2)) / depth).max(-kFarCells).min(kFarCells);
-                    Strided(map_x.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_x;
-                    Strided(map_y.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_y;
-                }
+        const int sample_rows = rows * n;
+        for (int sample_row = 0; sample_row < sample_rows; ++sample_row) {
+            const auto v = static_cast<std::size_t>(v0 + sample_row / n);
+            const float down = (static_cast<float>(sample_row % n) + 0.5F) / static_cast<float>(n);
+            const Row top_x(corner_x_.data() + v * stride, width + 1);
+            const Row top_y(corner_y_.data() + v * stride, width + 1);
+            const Row bottom_x(corner_x_.data() + (v + 1) * stride, width + 1);
+            const Row bottom_y(corner_y_.data() + (v + 1) * stride, width + 1);
+            row_x = top_x + down * (bottom_x - top_x);
+            row_y = top_y + down * (bottom_y - top_y);
+            for (int sample_col = 0; sample_col < n; ++sample_col) {
+                const float across = (static_cast<float>(sample_col) + 0.5F) / static_cast<float>(n);
+                sample_x = row_x.head(width) + across * (row_x.tail(width) - row_x.head(width));
+                sample_y = row_y.head(width) + across * (row_y.tail(width) - row_y.head(width));
+                // Below the horizon the depth is negative; a sky pixel's
+                // samples are pushed far off the window (it is painted sky).
+                depth = (h(2, 0) * sample_x + h(2, 1) * sample_y + h(2, 2)).min(-1e-6F);
+                seen_x = ((h(0, 0) * sample_x + h(0, 1) * sample_y + h(0, 2)) / depth).max(-kFarCells).min(kFarCells);
+                seen_y = ((h(1, 0) * sample_x + h(1, 1) * sample_y + h(1, 2)) / depth).max(-kFarCells).min(kFarCells);
+                Strided(map_x.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_x;
+                Strided(map_y.ptr<float>(sample_row) + sample_col, width, Eigen::InnerStride<>(n)) = seen_y;
             }
-            // Each sample reads the truth cell it falls in (the nearest cell
-            // centre), as render_scene's samples do: a pixel's mix at a leaf
-            // edge comes from its n x n samples, not from blurring the truth.
-            cv::convertMaps(map_x.rowRange(0, sample_rows), map_y.rowRange(0, sample_rows), fixed_xy, cv::noArray(), CV_16SC2, true);
-            cv::remap(view, samples, fixed_xy, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
-            if (n > 1) {
-                cv::resize(samples, cover, cv::Size(width, rows), 0.0, 0.0, cv::INTER_AREA);  // the mean of n x n
-            } else {
-                cover = samples;
-            }
-        } else {
-            cover = cv::Mat::zeros(rows, width, CV_8UC1);
         }
-        cv::cvtColor(cover, cover_rgb, cv::COLOR_GRAY2RGB);
-        cv::LUT(cover_rgb, cover_to_rgb, lit);
-        if (any_sky_) lit.setTo(sky, sky_pixels.rowRange(v0, v0 + rows));
-        if (!noise_.empty()) cv::add(lit, noise(cv::Rect(noise_u, noise_v + v0, width, rows)), lit);
-        cv::Mat band = frame.rowRange(v0, v0 + rows);
-        lit.convertTo(band, CV_8U, 1.0 / kSubDn);  // rounded (exact in binary: a power of two) and clipped to 0-255
+        // Each sample reads the truth cell it falls in (the nearest cell
+        // centre), as render_scene's samples do: a pixel's mix at a leaf
+        // edge comes from its n x n samples, not from blurring the truth.
+        cv::convertMaps(map_x.rowRange(0, sample_rows), map_y.rowRange(0, sample_rows), fixed_xy, cv::noArray(), CV_16SC2, true);
+        cv::remap(view, samples, fixed_xy, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(0));
+        cv::resize(samples, cover, cv::Size(width, rows), 0.0, 0.0, cv::INTER_AREA);  // the mean of n x n
+        each_band(v0, cover);
     }
-    if (faults.blur_radius_px > 0) box_blur(image, faults.blur_radius_px);
-    return image;
 }
 namespace {
 

@@ -19,13 +19,16 @@
 // inverse computed once per camera at the pixel corners. Per frame the two
 // compose into a per-sample map into a cover image (a block of the crop
 // truth's 1 mm raster, plant 255, soil 0, kept while the view stays inside
-// it), sampled bilinearly by OpenCV's fixed-point remap: a leaf edge inside a
-// sample gives a mixed value, as a pixel straddling it would. n x n samples
-// average to the pixel (area resize). Colour is a per-frame table from cover
-// to RGB; the noise a shifted window of a seeded per-camera table (a frame's
-// shift hashed from its index). All of it is integer arithmetic on maps fixed
-// to 1/32 px, so a frame's bytes are a function of the case, seed, pose and
-// frame index alone, whatever the machine or the order frames are rendered in.
+// it), each sample the cell it falls in (OpenCV's fixed-point remap, nearest
+// cell; at one sample a pixel the same arithmetic in one pass a row). n x n
+// samples average to the pixel (area resize), so a pixel straddling a leaf
+// edge is mixed. Colour is a per-frame table from cover to RGB; the noise a
+// shifted window of a seeded per-camera table (a frame's shift hashed from
+// its index); the two summed in 1/64 DN and rounded in one pass a row. After
+// the map it is integer arithmetic, and the map single-precision IEEE
+// arithmetic rounded to a cell, so a frame's bytes are a function of the
+// case, seed, pose and frame index alone, whatever the machine or the order
+// frames are rendered in.
 // Views reaching far (the window would exceed 24 M cells, e.g. a camera pitched
 // near the horizon) and the calibration scenes (boards, chessboards: a few
 // frames a run) take the exact per-sample path instead: corner rays through
@@ -47,6 +50,10 @@
 #include "emulators/field2d/vec2.h"
 #include "rig/camera/pinhole_camera.h"
 #include "rig/camera/rgb_image.h"
+
+namespace cv {
+class Mat;
+}  // namespace cv
 
 namespace rig::emulators::vision {
 
@@ -174,6 +181,11 @@ private:
     // east_last] x [north_first, north_last] of `crop` already.
     void hold_cells(const rig::field2d::CropCoverMap& crop, std::int64_t east_first, std::int64_t east_last,
                     std::int64_t north_first, std::int64_t north_last) const;
+    // With n x n samples a pixel (n > 1): the frame's cover (0 soil .. 255
+    // plant), the mean of each pixel's samples, a band of rows at a time,
+    // handed to each_band with the band's first row.
+    void render_cover_bands(const Eigen::Matrix3f& h, const cv::Mat& view,
+                            const std::function<void(int, const cv::Mat&)>& each_band) const;
     // What lies on a plane at boom-frame (x, y): a board's colour, or nothing.
     using PlaneOverlay = std::function<std::optional<rig::camera::Rgb>(double x_m, double y_m)>;
     std::optional<rig::camera::RgbImage> render_scene(const rig::field2d::CropCoverMap& crop, const BoomPose& pose,
