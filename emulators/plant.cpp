@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <string>
 
 #include "idl/topics.h"
 
@@ -33,11 +32,12 @@ Plant::Plant(const PlantParams& params)
     // The rear axle's along position is the antenna's less its mounting; the
     // line's route distance starts well behind anywhere the axle can be.
     const double axle_behind_antenna_m = params_.antenna.forward_of_rear_axle_m;
-    double lowest_axle_m = std::numeric_limits<double>::infinity();
+    // Drives only go forward: each pass's lowest position is its start.
+    double lowest_antenna_m = std::numeric_limits<double>::infinity();
     for (int pass = 0; std::isfinite(vehicle_.pass_start_s(pass)); ++pass) {
-        lowest_axle_m = std::min(lowest_axle_m, vehicle_.state_at(vehicle_.pass_start_s(pass)).antenna_along_m);
+        lowest_antenna_m = std::min(lowest_antenna_m, vehicle_.state_at(vehicle_.pass_start_s(pass)).antenna_along_m);
     }
-    const double line_origin_m = lowest_axle_m - axle_behind_antenna_m - 100.0;
+    const double line_origin_m = lowest_antenna_m - axle_behind_antenna_m - 100.0;
     const VehiclePlant route = vehicle_;
     const guidance::SpeedProfile speed = [route](double t_s) { return route.state_at(t_s).speed_m_s; };
     const guidance::BodyPoint antenna{0.0, params_.antenna.forward_of_rear_axle_m, params_.antenna.height_m};

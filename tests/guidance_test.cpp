@@ -15,6 +15,7 @@
 #include "emulators/guidance/ground_roughness.h"
 #include "emulators/guidance/guided_path.h"
 #include "emulators/plant.h"
+#include "harness/judge/guidance_metrics.h"
 
 namespace {
 
@@ -279,6 +280,24 @@ TEST(Guidance, Seed000ComesBackToTheLineOffsetAfterEachHeadlandTurn) {
     // Steered back onto the line by the end of each pass.
     EXPECT_LT(std::abs(guided.truth_at(rig::seconds_to_ns(turn_s - 0.5)).cross_m()), 0.005);
     EXPECT_LT(std::abs(guided.truth_at(rig::seconds_to_ns(exact.vehicle().end_time_s())).cross_m()), 0.005);
+}
+
+TEST(Guidance, TheJudgeTakesTheErrorOverTheMovingSamples) {
+    using rig::harness::GuidanceErrorSample;
+    // Standing (0.05 m/s) is left out, however far off: RMS of 3 and -4 cm is
+    // sqrt((9 + 16) / 2) = 3.536 cm, the peak 4 cm; headings 1 and -2 deg: sqrt(2.5).
+    const rig::harness::MetricSet judged = rig::harness::guidance_metrics(
+        {GuidanceErrorSample{0.03, 1.0, 1.0}, GuidanceErrorSample{-0.04, -2.0, 1.5}, GuidanceErrorSample{1.0, 30.0, 0.05}},
+        "axle");
+    EXPECT_NEAR(judged.values.at("guidance_axle_cross_track_rms_m"), std::sqrt(0.00125), 1e-15);
+    EXPECT_DOUBLE_EQ(judged.values.at("guidance_axle_cross_track_peak_m"), 0.04);
+    EXPECT_NEAR(judged.values.at("guidance_heading_error_rms_deg"), std::sqrt(2.5), 1e-15);
+    EXPECT_EQ(judged.values.at("guidance_moving_samples"), 2.0);
+    // Never moving: not measured, saying why, rather than a zero error.
+    const rig::harness::MetricSet standing =
+        rig::harness::guidance_metrics({GuidanceErrorSample{0.5, 3.0, 0.0}}, "antenna");
+    EXPECT_EQ(standing.values.count("guidance_antenna_cross_track_rms_m"), 0u);
+    EXPECT_NE(standing.not_measured.at("guidance_antenna_cross_track_rms_m").find("never moved"), std::string::npos);
 }
 
 }  // namespace
