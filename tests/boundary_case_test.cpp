@@ -211,6 +211,26 @@ TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
     EXPECT_NE(load_error(edited("system: boundary", "system: boundry")).find("did you mean 'boundary'"), std::string::npos);
 }
 
+// `guidance:` (docs/guidance.md): absent, the route is driven exactly; `{}`
+// takes every default; a value outside its bounds or an unknown key is an
+// error at the section, naming the key.
+TEST(BoundaryCase, GuidanceIsOptInAndItsValuesAreHeldToTheirBounds) {
+    const auto guidance_of = [](const std::string& text) { return boundary_sections(parse_case(text, "case.yaml")).guidance; };
+    EXPECT_FALSE(guidance_of(edited("judge:\n", "judge:\n")).has_value());
+    const auto defaults = guidance_of(edited("judge:\n", "guidance: {}\njudge:\n"));
+    ASSERT_TRUE(defaults.has_value());
+    EXPECT_EQ(defaults->wheelbase_m, rig::emulators::guidance::GuidanceParams{}.wheelbase_m);
+    EXPECT_EQ(guidance_of(edited("judge:\n", "guidance: { wheelbase_m: 2.4 }\njudge:\n"))->wheelbase_m, 2.4);
+    const std::string bounds = load_error(edited("judge:\n", "guidance: { terrain_compensation: 1.5 }\njudge:\n"));
+    EXPECT_NE(bounds.find("case.yaml:"), std::string::npos) << bounds;
+    EXPECT_NE(bounds.find("guidance.terrain_compensation: must be in [0.000000, 1.000000]"), std::string::npos) << bounds;
+    const std::string unknown = load_error(edited("judge:\n", "guidance: { wheelbase: 2.4 }\njudge:\n"));
+    EXPECT_NE(unknown.find("guidance.wheelbase"), std::string::npos) << unknown;
+    // Seed 000's antenna keys are not seed 001's (its antenna is sprayer.mounting's).
+    EXPECT_NE(load_error(edited("judge:\n", "guidance: { antenna_height_m: 2 }\njudge:\n")).find("antenna_height_m"),
+              std::string::npos);
+}
+
 // The bench path's keys (docs/seed001-boundary.md "Bench path"): the shipped
 // wired case reads as written; each wire that cannot work is refused at its key.
 TEST(BoundaryCase, BenchWiringReadsAndWhatCannotWorkIsRefusedAtItsKey) {

@@ -12,12 +12,15 @@
 // so with 6 nozzles 0.5 m apart (Table 1) nozzle 0 is 1.25 m left of the boom
 // centre and nozzle 5 1.25 m right (numbering left to right facing the travel
 // direction: assumed, the paper's Fig. 16 does not say).
+#include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "emulators/field2d/boom_lift.h"
 #include "emulators/field2d/local_frame.h"
 #include "emulators/field2d/route2d.h"
 #include "emulators/field2d/vec2.h"
+#include "emulators/guidance/guided_path.h"
 #include "rig/papers/seed001.h"
 
 namespace rig::field2d {
@@ -51,11 +54,22 @@ struct SprayerTruth {
     std::vector<Vec2> nozzles;          // ground points under each nozzle, index = nozzle number
 };
 
+// With guidance (emulators/guidance/guided_path.h), the rear axle is not on the
+// route but steered along it by autosteer over a rough ground: the pose is the
+// guided vehicle's, the antenna sits on the rolling, pitching body (its ground
+// point moves h sin(roll) sideways, its height is h cos(roll) cos(pitch)), and
+// the boom and nozzles follow the body's yaw. The boom's own roll with the body
+// is not modelled (its fan lands where the level boom's would).
+// Without guidance the route is driven exactly, as before (bit for bit).
 class SprayerKinematics {
 public:
     // Throws std::invalid_argument for a bad mounting or a height profile the
-    // lift cannot reach (naming the height and the lift's range).
-    SprayerKinematics(LocalFrame frame, Route2d route, SprayerMounting mounting, BoomHeightProfile height);
+    // lift cannot reach (naming the height and the lift's range), or bad
+    // guidance parameters (naming guidance.<field>). `seed` draws the guided
+    // ground (the run's seed).
+    SprayerKinematics(LocalFrame frame, Route2d route, SprayerMounting mounting, BoomHeightProfile height,
+                      std::optional<emulators::guidance::GuidanceParams> guidance = std::nullopt,
+                      std::uint64_t seed = 1);
 
     SprayerTruth truth_at(double t_s) const;
     double boom_height_at(double t_s) const { return height_.height_at(t_s); }
@@ -64,12 +78,19 @@ public:
     const Route2d& route() const { return route_; }
     const SprayerMounting& mounting() const { return mounting_; }
     const BoomHeightProfile& height_profile() const { return height_; }
+    // The autosteer's run (nullptr when the route is driven exactly).
+    const emulators::guidance::GuidedPath* guided() const { return guided_ ? &*guided_ : nullptr; }
 
 private:
     LocalFrame frame_;
     Route2d route_;
     SprayerMounting mounting_;
     BoomHeightProfile height_;
+    std::optional<emulators::guidance::GuidedPath> guided_;
 };
+
+// The route as the autosteer follows it: its rear-axle pose at a path length
+// (extended straight past the end, where the look-ahead reaches beyond it).
+emulators::guidance::ReferencePath reference_path_of(const Route2d& route);
 
 }  // namespace rig::field2d

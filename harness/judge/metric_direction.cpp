@@ -53,6 +53,11 @@ const std::vector<MetricDeclaration> kDeclarations = {
     // Seed 000: the GNSS wire's faults, set by the case
     {"gnss_*_count", W::none, 0.0, "sentences the case's wire faults damaged: the case's input"},
     {"controller_nmea_rejected_count", W::none, 0.0, "sentences the controller says it refused: its own report"},
+    // Both seeds with `guidance:` (docs/guidance.md): the autosteer's error from truth.
+    {"guidance_*_cross_track_rms_m", W::up, 0.002, "RMS offset of the vehicle point from the route"},
+    {"guidance_*_cross_track_peak_m", W::up, 0.005, "the largest offset"},
+    {"guidance_heading_error_rms_deg", W::up, 0.05, "RMS heading error against the route"},
+    {"guidance_moving_samples", W::none, 0.0, "truth samples judged: the route's"},
     // Seed 001: boundary shut-off (Tables 7, 8). The wet edge's signed
     // distance past the boundary: + sprays outside the area, - leaves its edge
     // dry. The cases limit the mean from above (the paper's concern is spray

@@ -208,6 +208,7 @@ std::shared_ptr<const BoundarySections> read_boundary_sections(const YamlSection
     if (spec.route_segments.size() > 1000) route.fail("segments", "at most 1000 segments");
 
     read_mounting(root.section("sprayer"), spec);
+    spec.guidance = read_guidance_section(root);
 
     const YamlSection spray = root.section("spray");
     read(spray, "fan_angle_deg", spec.spray.fan_angle_deg);
@@ -359,7 +360,8 @@ void BoundarySections::check_with(const CaseSpec& common, const YamlSection& roo
     if (route->end_time_s() > 3600.0) root.section("route").fail("the route lasts more than an hour");
     std::optional<field2d::SprayerKinematics> kinematics;
     checked(root.section("sprayer"), [&] {
-        kinematics.emplace(frame, *route, spec.mounting, field2d::BoomHeightProfile(spec.boom_height));
+        kinematics.emplace(frame, *route, spec.mounting, field2d::BoomHeightProfile(spec.boom_height), spec.guidance,
+                           common.seed);
     });
     checked(root.section("spray"), [&] {
         const field2d::NozzleFlowTable table = spec.flow_table_or_paper();

@@ -16,6 +16,8 @@
 //             default_cover, patches: [ { cover, corners: [ { east_m, north_m } ] } ]},
 //             cameras: {CameraEmulatorParams fields for both}, left: / right:
 //             { faults: { pitch_offset_deg, blur_radius_px, colour_cast, dead } }
+//   guidance: autosteer over a rough ground instead of the exact route
+//             (harness/spec/guidance_section.h, docs/guidance.md); absent: exact
 //   judge:    ground grid, wet threshold, the edges to measure and the metric
 //             each gives, flow per duty (Table 3), centre_rule (Sec. 4.2's
 //             boom-centre rule, Table 8 "along, boom centre outside"), vision
@@ -47,6 +49,7 @@
 #include "harness/systems/boundary/boundary_metrics.h"
 #include "harness/systems/boundary/vision_metrics.h"
 #include "harness/spec/case_spec.h"
+#include "harness/spec/guidance_section.h"
 #include "rig/config/yaml_fields.h"
 
 namespace rig::harness {
@@ -95,6 +98,7 @@ public:
     field2d::RouteStart route_start;
     std::vector<field2d::RouteSegment> route_segments;
     field2d::SprayerMounting mounting;
+    std::optional<emulators::guidance::GuidanceParams> guidance;  // absent: the route driven exactly
     std::vector<field2d::HeightKnot> boom_height{field2d::HeightKnot{0.0, 0.5}};
     emulators::SprayDepositionParams spray;
     std::vector<std::vector<field2d::FlowPoint>> flow_table;  // empty: Table 3 as printed

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "emulators/field2d/polygon.h"
+#include "harness/judge/guidance_metrics.h"
 #include "harness/systems/boundary/boundary_figures.h"
 #include "idl/topics.h"
 #include "rig/text/number_text.h"
@@ -75,6 +76,17 @@ BoundaryJudgingPlan plan_boundary_judging(const BoundarySections& spec) {
     plan.papers = spec.papers;
     plan.dose_strip = spec.dose_strip;
     plan.coverage = spec.coverage;
+    if (spec.guidance) {
+        const field2d::Route2d route(spec.route_start, spec.route_segments);
+        const emulators::guidance::ReferencePath path = field2d::reference_path_of(route);
+        const double length_m = route.total_distance_m();
+        const double spacing_m = std::max(kGuidanceRouteSpacingM, length_m / static_cast<double>(kGuidanceRouteMaxPoints - 1));
+        for (double d = 0.0;; d += spacing_m) {
+            const emulators::guidance::PathPose at = path(std::min(d, length_m));
+            plan.guidance_route.push_back({at.position.east_m, at.position.north_m, at.heading_deg});
+            if (d >= length_m) break;
+        }
+    }
     return plan;
 }
 
@@ -122,6 +134,7 @@ nlohmann::json to_json(const BoundaryJudgingPlan& plan) {
                                     e.eq13_intercept_l_min, e.level0_max_pct, e.level1_max_pct, e.level1_duty_pct,
                                     e.level2_duty_pct}}};
     }
+    if (!plan.guidance_route.empty()) json["guidance_route"] = plan.guidance_route;
     if (!plan.papers.empty() || plan.dose_strip) {
         nlohmann::json papers = nlohmann::json::array();
         for (const field2d::Vec2& p : plan.papers) papers.push_back({p.east_m, p.north_m});
@@ -195,6 +208,13 @@ BoundaryJudgingPlan boundary_judging_plan_from_json(const nlohmann::json& json) 
             const std::vector<double> r = json.at("dose_strip").get<std::vector<double>>();
             if (r.size() != 4) throw std::runtime_error("boundary judging plan: dose_strip needs 4 numbers");
             plan.dose_strip = GroundRect{r[0], r[1], r[2], r[3]};
+        }
+        if (json.contains("guidance_route")) {
+            plan.guidance_route = json.at("guidance_route").get<std::vector<std::array<double, 3>>>();
+            if (plan.guidance_route.size() > kGuidanceRouteMaxPoints) {
+                throw std::runtime_error("boundary judging plan: guidance_route has more than " +
+                                         std::to_string(kGuidanceRouteMaxPoints) + " points");
+            }
         }
         if (plan.centre_rule && plan.area.size() < 3) {
             throw std::runtime_error("boundary judging plan: centre_rule needs `area` with at least 3 corners");
@@ -381,8 +401,45 @@ DoseCells dose_cells(const DoseRaster& total, const GroundRect& rect, const std:
     return cells;
 }
 
+namespace {
+
+// The rear axle's offset from the route and its heading error, per truth/vehicle2d
+// sample: against the nearest route point (searched near the last one, the
+// samples coming in time order), along that point's normal.
+std::vector<GuidanceErrorSample> guidance_errors(const RecordedTrace& trace,
+                                                 const std::vector<std::array<double, 3>>& route) {
+    std::vector<GuidanceErrorSample> errors;
+    std::size_t nearest = 0;
+    bool first = true;
+    for (const RecordedSample& s : trace.samples(topics::kVehicle2dTruth)) {
+        const field2d::Vec2 axle{s.json.at("east_m").get<double>(), s.json.at("north_m").get<double>()};
+        const auto distance_sq = [&](std::size_t i) {
+            const field2d::Vec2 d = axle - field2d::Vec2{route[i][0], route[i][1]};
+            return field2d::dot(d, d);
+        };
+        // The first sample searches the whole route, the rest a stretch around the last match.
+        const std::size_t window = 400;
+        const std::size_t from = first ? 0 : (nearest > window ? nearest - window : 0);
+        const std::size_t to = first ? route.size() : std::min(route.size(), nearest + window + 1);
+        first = false;
+        for (std::size_t i = from; i < to; ++i) {
+            if (distance_sq(i) < distance_sq(nearest)) nearest = i;
+        }
+        const std::array<double, 3>& at = route[nearest];
+        GuidanceErrorSample error;
+        error.cross_track_m = field2d::dot(axle - field2d::Vec2{at[0], at[1]}, field2d::right_of(at[2]));
+        error.heading_error_deg = std::remainder(s.json.at("heading_deg").get<double>() - at[2], 360.0);
+        error.speed_m_s = s.json.at("speed_m_s").get<double>();
+        errors.push_back(error);
+    }
+    return errors;
+}
+
+}  // namespace
+
 MetricSet boundary_trace_metrics(const RecordedTrace& trace, const BoundaryJudgingPlan& plan) {
     MetricSet metrics;
+    if (!plan.guidance_route.empty()) metrics.merge(guidance_metrics(guidance_errors(trace, plan.guidance_route), "axle"));
     const std::vector<NozzleStepTruth> steps = nozzle_step_truth(trace);
     std::optional<DoseRaster> total;  // the ground, when something below needs it
     if (plan.vision.enabled || !plan.papers.empty() || plan.dose_strip) total = sum_rasters(ground_from_truth(steps, plan));

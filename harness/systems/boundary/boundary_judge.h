@@ -8,6 +8,7 @@
 // height of that instant. The metrics are then harness/systems/boundary/boundary_metrics.h's.
 // What to measure (the ground grid, the edges, the flow table) is the plan the
 // run wrote from the case file into meta `judging`, key `boundary`.
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,7 +48,13 @@ struct BoundaryJudgingPlan {
     std::vector<field2d::Vec2> papers;     // Tables 4-6's papers (centres), local frame
     std::optional<GroundRect> dose_strip;  // dose per area judged over it
     CoverageModel coverage;
+    // With `guidance:`: the route the autosteer followed, its rear-axle pose
+    // every kGuidanceRouteSpacingM or so (east, north, heading), for the
+    // guidance_* metrics (harness/judge/guidance_metrics.h); empty without.
+    std::vector<std::array<double, 3>> guidance_route;
 };
+inline constexpr double kGuidanceRouteSpacingM = 0.05;
+inline constexpr std::size_t kGuidanceRouteMaxPoints = 100000;
 
 // From the case: the area's edges in the local frame (its corners through the
 // case's ENU origin), each edge the one nearest the case's `near` point.

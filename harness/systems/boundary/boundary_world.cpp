@@ -16,7 +16,7 @@ namespace rig::harness {
 
 BoundaryWorld::BoundaryWorld(const BoundarySections& spec, std::uint64_t seed)
     : kinematics(spec.frame(), field2d::Route2d(spec.route_start, spec.route_segments), spec.mounting,
-                 field2d::BoomHeightProfile(spec.boom_height)),
+                 field2d::BoomHeightProfile(spec.boom_height), spec.guidance, seed),
       valves(spec.valves),
       ad300(spec.ad300),
       laser(spec.laser) {

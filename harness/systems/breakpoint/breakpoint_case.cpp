@@ -475,6 +475,19 @@ std::shared_ptr<const BreakpointSections> read_breakpoint_sections(const YamlSec
     own->boom_height_sensor = read_boom_height_sensor(root.section("boom_height_sensor"));
     own->deposition = read_deposition(root.section("deposition"));
     own->static_flow = read_static_flow(root.section("static_flow"));
+    own->guidance = read_guidance_section(root);
+    if (own->guidance) {
+        const YamlSection guidance = root.section("guidance");
+        own->antenna.forward_of_rear_axle_m = guidance.optional_in_range<double>(
+            "antenna_forward_of_axle_m", own->antenna.forward_of_rear_axle_m, Bounds::closed(-1e9, 1e9));
+        own->antenna.height_m = guidance.optional_in_range<double>("antenna_height_m", own->antenna.height_m,
+                                                                   Bounds::closed(-1e9, 1e9));
+        try {
+            emulators::guidance::validate(own->antenna, "guidance");
+        } catch (const std::invalid_argument& error) {
+            guidance.fail(error.what());
+        }
+    }
     // The harness judges flow against the target the controller is given
     // (boom-sprayer pumps deliver at most ~200 L/min; see hydraulics). Read
     // through a section of its own, never finish()ed: the rest of the

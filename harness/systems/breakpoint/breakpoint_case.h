@@ -29,6 +29,7 @@
 #include "emulators/vehicle_plant.h"
 #include "emulators/wheel_encoder_params.h"
 #include "harness/spec/case_spec.h"
+#include "harness/spec/guidance_section.h"
 
 namespace rig::harness {
 
@@ -290,6 +291,12 @@ public:
     BoomHeightSensorSpec boom_height_sensor;
     DepositionSpec deposition;
     StaticFlowSpec static_flow;
+    // `guidance:` (harness/spec/guidance_section.h, docs/guidance.md): autosteer
+    // along the A-B line over a rough ground; absent, the line is driven
+    // exactly. Its antenna_forward_of_axle_m and antenna_height_m place the
+    // antenna on the body (emulators/guidance/guidance_params.h's AntennaMount).
+    std::optional<emulators::guidance::GuidanceParams> guidance;
+    emulators::guidance::AntennaMount antenna;
     // The flow the controller is told to hold (the controller section's
     // `target_flow_l_min`, 20 L/min if absent, docs/controller-contract.md); the
     // judge holds the flow to the same number.

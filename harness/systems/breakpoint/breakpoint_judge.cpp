@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "emulators/field_frame.h"
+#include "harness/judge/guidance_metrics.h"
 #include "harness/systems/breakpoint/breakpoint_figures.h"
 #include "harness/systems/breakpoint/gnss_wire_faults.h"
 #include "idl/topics.h"
@@ -29,6 +30,7 @@ void add_breakpoint_keys(const BreakpointJudgingPlan& plan, nlohmann::json& json
         {"judge_flow", plan.judge_flow},
         {"judge_deposition", plan.judge_deposition},
     });
+    if (plan.judge_guidance) json["judge_guidance"] = true;
     if (plan.judge_flow) {
         json["flow"] = {{"target_l_min", plan.flow.target_l_min},
                         {"band_pct", plan.flow.band_pct},
@@ -74,6 +76,7 @@ BreakpointJudgingPlan breakpoint_judging_plan_from_json(const nlohmann::json& js
         plan.judge_breakpoint = at(json, "judge_breakpoint", "").get<bool>();
         plan.judge_flow = at(json, "judge_flow", "").get<bool>();
         plan.judge_deposition = at(json, "judge_deposition", "").get<bool>();
+        plan.judge_guidance = json.contains("judge_guidance") && at(json, "judge_guidance", "").get<bool>();
         if (plan.judge_flow) {
             const nlohmann::json& flow = at(json, "flow", "");
             plan.flow.target_l_min = at(flow, "target_l_min", "flow.").get<double>();
@@ -295,6 +298,17 @@ SystemJudgement judge_breakpoint_trace(const RecordedTrace& trace, const Breakpo
         const DepositionResult deposition = deposition_metrics(profile, plan.deposition, plan.breakpoint_along_m);
         metrics.merge(deposition.metrics);
         add_dose_figure(profile, deposition, plan.breakpoint_along_m, plan.deposition.cv_window_m, *figures);
+    }
+    if (plan.judge_guidance) {
+        // Truth's antenna: cross_m is its offset right of the A-B line.
+        std::vector<GuidanceErrorSample> errors;
+        for (const RecordedSample& sample : trace.samples(topics::kVehicleTruth)) {
+            errors.push_back(GuidanceErrorSample{
+                sample.json.at("cross_m").get<double>(),
+                std::remainder(sample.json.at("heading_deg").get<double>() - plan.field_heading_deg, 360.0),
+                sample.json.at("speed_m_s").get<double>()});
+        }
+        metrics.merge(guidance_metrics(errors, "antenna"));
     }
     metrics.merge(gnss_wire_fault_metrics(trace));  // cases with gnss.wire_faults only
     return SystemJudgement{std::move(metrics), std::move(figures)};

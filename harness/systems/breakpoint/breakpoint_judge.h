@@ -36,6 +36,10 @@ struct BreakpointJudgingPlan : JudgingPlan {
     bool judge_fig11 = false;
     bool judge_deposition = false;
     DepositionJudging deposition;
+    // With `guidance:`: the antenna's offset from the A-B line and the heading
+    // error from truth/vehicle (harness/judge/guidance_metrics.h). The key is
+    // only written when true, so plans without guidance stay byte for byte.
+    bool judge_guidance = false;
 };
 // Seed 000's keys, added to `json` (the common ones are JudgingPlan's).
 void add_breakpoint_keys(const BreakpointJudgingPlan& plan, nlohmann::json& json);

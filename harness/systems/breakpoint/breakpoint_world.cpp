@@ -154,6 +154,8 @@ BreakpointWorld build_case_world(const BreakpointSections& spec, std::uint64_t s
     plant_params.wheel.deflection_pct = spec.encoder.deflection_pct;
     plant_params.wheel.terrain_sd_m_per_sqrt_m = spec.encoder.terrain_sd_m_per_sqrt_m;
     plant_params.seed = seed;
+    plant_params.guidance = spec.guidance;
+    plant_params.antenna = spec.antenna;
     emulators::Plant plant(plant_params);
     const double breakpoint_along_m =
         scenario.button.empty() ? spec.breakpoint.along_m
@@ -189,6 +191,7 @@ BreakpointJudgingPlan plan_judging(const BreakpointSections& spec, const Breakpo
         plan.flow_window.to_ns = seconds_to_ns(spec.static_flow.spray_on_at_s + spec.static_flow.spray_for_s);
     }
     plan.judge_deposition = spec.scenario_kind == Scenario::breakpoint_continuation;
+    plan.judge_guidance = spec.guidance.has_value();
     const emulators::VehiclePlant& vehicle = world.plant.vehicle();
     // The strip that must be sprayed: the first pass's start to the end of the
     // continuation, less the allowances at either end (breakpoint_case.h DepositionSpec).
