@@ -63,6 +63,30 @@ TEST(InProcess, SameCaseAndSeedGiveTheSameTraceInBothModes) {
     ASSERT_FALSE(a.value("trace_sha256", "").empty());
     EXPECT_EQ(a.value("trace_sha256", ""), b.value("trace_sha256", "")) << "the in-process trace differs";
     EXPECT_EQ(a["metrics"], b["metrics"]);
+    // In process the samples are handed over without DDS (rig/runtime/dds_context.h
+    // LocalBus): the same instants and the same rounds as over DDS.
+    EXPECT_EQ(a.value("instants", 0), b.value("instants", 0));
+    EXPECT_GT(a.value("rounds", 0), 0);
+    EXPECT_EQ(a.value("rounds", 0), b.value("rounds", 0));
+}
+
+TEST(InProcess, TheFusionCaseGivesTheSameTraceInBothModesAndRunToRun) {
+    // Every device of seed 000 and the reference plugin, its samples handed
+    // over in the rig's process (rig/runtime/dds_context.h LocalBus).
+    const std::filesystem::path dir = fresh_dir("in_process_fusion_digest");
+    const std::string case_file = (kCases / "table3-fusion" / "table3-fusion-6kmh-s1.yaml").string();
+    const RunResult process = rig_run(case_file, dir / "process");
+    const RunResult first = rig_run(case_file + " --in-process", dir / "first");
+    const RunResult second = rig_run(case_file + " --in-process", dir / "second");
+    ASSERT_EQ(process.exit_code, 0) << process.output;
+    ASSERT_EQ(first.exit_code, 0) << first.output;
+    ASSERT_EQ(second.exit_code, 0) << second.output;
+    const std::string digest = only_case(process).value("trace_sha256", "");
+    ASSERT_FALSE(digest.empty());
+    EXPECT_EQ(only_case(first).value("controller_mode", ""), "in_process");
+    EXPECT_EQ(only_case(first).value("trace_sha256", ""), digest);
+    EXPECT_EQ(only_case(second).value("trace_sha256", ""), digest);
+    EXPECT_EQ(only_case(first).value("rounds", 0), only_case(process).value("rounds", 0));
 }
 
 TEST(InProcess, AForgedTruthTopicIsCaughtInProcessToo) {

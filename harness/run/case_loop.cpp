@@ -11,6 +11,7 @@
 #include "harness/session/board_attach.h"
 #include "harness/trace/topic_roles.h"
 #include "idl/topics.h"
+#include "rig/host/heap_count.h"
 #include "rig/runtime/failure_kind.h"
 #include "rig/runtime/lockstep.h"
 #include "rig/runtime/realtime.h"
@@ -245,8 +246,10 @@ void run_lockstep(const TimeoutsSpec& timeouts, DdsContext& dds, SystemNodes& no
     try {
         start_hellos_first(master, watchdog);
         facts.startup_wall_seconds = wall.elapsed_s();
+        const std::uint64_t allocations_before = heap_allocations();
         while (master.advance(end_ns)) ++facts.instants;
         facts.stepping_wall_seconds = wall.elapsed_s() - facts.startup_wall_seconds;
+        add_stepping_allocations(heap_allocations() - allocations_before);
         master.shutdown();
     } catch (const NodeFailure&) {
         master.shutdown(/*after_failure=*/true);

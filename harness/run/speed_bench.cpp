@@ -21,6 +21,7 @@
 #include "harness/judge/case_result.h"
 #include "harness/output/atomic_file.h"
 #include "rig/host/cpu_lease.h"
+#include "rig/host/heap_count.h"
 #include "rig/runtime/dds_security.h"
 #include "rig/runtime/thread_id_cache.h"
 #include "rig/text/number_text.h"
@@ -33,6 +34,7 @@ struct ModeRuns {
     std::vector<CaseResult> runs;
     std::vector<int> repeat_of;  // per run: which repeat (0-based) it belongs to
     std::uint64_t context_switches = 0;  // over all its runs (context_switches_so_far)
+    std::uint64_t stepping_allocations = 0;  // over all its runs, while stepping (rig/host/heap_count.h)
 };
 
 // Context switches, voluntary and not, of every thread of this process and of
@@ -251,8 +253,10 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 const RigIdentityScope rig_identity(secured ? credentials : std::nullopt);
                 const std::vector<CaseInstance> instances = expand_runs({spec}, run_options);
                 const std::uint64_t switches_before = context_switches_so_far();
+                const std::uint64_t allocations_before = stepping_allocations();
                 const CaseRun run = run_case(spec, instances.front().seed, instances.front().name, run_options);
                 mode.context_switches += context_switches_so_far() - switches_before;
+                mode.stepping_allocations += stepping_allocations() - allocations_before;
                 const CaseResult& result = run.result;
                 const std::string expected_mode = mode.mode == "in_process" ? "in_process" : "process";
                 if (!result.error.empty() || result.controller_mode != expected_mode) {
@@ -355,6 +359,17 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
         << ", SIL " << fixed_text(in_process_switches_per_round, 1) << "; any CPU: ping-pong "
         << fixed_text(floor_switches_free_per_round, 1) << ", process mode " << fixed_text(process_unpinned_switches_per_round, 1)
         << "\n";
+    // Allocations a round while stepping (issue 32): the rig's process only.
+    const double process_allocations_per_round = per_round(modes[0].stepping_allocations, process.rounds);
+    const double in_process_allocations_per_round = per_round(modes[2].stepping_allocations, in_process.rounds);
+    if (heap_allocations_counted()) {
+        out << "  heap allocations a round while stepping (operator new on the lockstep's thread: the rig's nodes, a\n"
+               "  plugin, the recorder's drain; not the controller process's, nor SQLite's own malloc): process mode "
+            << fixed_text(process_allocations_per_round, 1) << ", SIL " << fixed_text(in_process_allocations_per_round, 1)
+            << "\n";
+    } else {
+        out << "  heap allocations: not counted (this program has no counting operator new, rig/host/heap_count.h)\n";
+    }
     if (process.us_per_round > 0.0 && pinned_floor.result.p50_us > 0.0) {
         out << "  one CPU against any CPU: process mode " << fixed_text(process_unpinned.us_per_round / process.us_per_round, 2)
             << "x as fast a round, the ping-pong " << fixed_text(free_floor.result.p50_us / pinned_floor.result.p50_us, 2)
@@ -399,6 +414,10 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
     json["process"]["context_switches_per_round"] = process_switches_per_round;
     json["process_unpinned"]["context_switches_per_round"] = process_unpinned_switches_per_round;
     json["in_process"]["context_switches_per_round"] = in_process_switches_per_round;
+    if (heap_allocations_counted()) {
+        json["process"]["allocations_per_round"] = process_allocations_per_round;
+        json["in_process"]["allocations_per_round"] = in_process_allocations_per_round;
+    }
     json["pingpong"]["context_switches_per_round"] = floor_switches_pinned_per_round;
     json["pingpong_unpinned"]["context_switches_per_round"] = floor_switches_free_per_round;
     if (secured) {

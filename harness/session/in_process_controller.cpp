@@ -44,6 +44,11 @@ std::unique_ptr<InProcessController> InProcessController::make(const std::shared
     // follower process would have; a guest of the harness's.
     controller->dds_ = std::make_unique<DdsContext>(harness_dds.domain_id(), "controller");
     harness_dds.add_guest_participant(controller->dds_->guid_prefix());
+    // With the controller here, every node of the case lives in this process:
+    // its samples go from writer to readers by hand-off (rig/runtime/dds_context.h
+    // LocalBus), DDS only to readers outside it (an observer on the domain).
+    if (!harness_dds.local_bus()) harness_dds.join_local_bus(std::make_shared<LocalBus>());
+    controller->dds_->join_local_bus(harness_dds.local_bus());
     controller->node_ = std::move(made.node);
     return controller;
 }

@@ -19,7 +19,9 @@ std::shared_ptr<NodePluginLibrary> load_controller_plugin(const std::filesystem:
 
 // One run's in-process controller: its node, on a DDS participant of its own,
 // registered with the harness's as a guest (its endpoints and samples are
-// judged like a process's), its log in the case directory.
+// judged like a process's), its log in the case directory. Both participants
+// join one LocalBus (rig/runtime/dds_context.h): the case's samples are
+// handed over in the process, not sent through DDS.
 class InProcessController {
 public:
     // Throws std::runtime_error when the plugin fails to make the node; a

@@ -131,6 +131,18 @@ void delete_writer(dds::Publisher& publisher, dds::DataWriter* writer) {
     publisher.delete_datawriter(writer);
 }
 
+constexpr std::size_t kPrefixBytes = eprosima::fastrtps::rtps::GuidPrefix_t::size;
+
+std::string hex_prefix(const unsigned char* bytes, std::size_t size) {
+    static const char* digits = "0123456789abcdef";
+    std::string hex;
+    for (std::size_t i = 0; i < size; ++i) {
+        hex += digits[bytes[i] >> 4];
+        hex += digits[bytes[i] & 0xf];
+    }
+    return hex;
+}
+
 }  // namespace
 
 WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* topic, bool counts_as_output)
@@ -145,19 +157,29 @@ WriterBase::WriterBase(DdsContext& context, std::string topic_name, dds::Topic* 
     }
     writer_ = context_->publisher().create_datawriter(topic, qos, &listener_, dds::StatusMask::publication_matched());
     if (writer_ == nullptr) throw std::runtime_error("cannot create DDS writer on topic " + topic_name_);
+    if (const std::shared_ptr<LocalBus>& bus = context_->local_bus()) {
+        type_name_ = topic->get_type_name();
+        local_readers_ = &bus->readers_of(topic_name_, type_name_);
+        member_dds_readers_ = &bus->dds_readers_of(topic_name_);
+        local_member_ = context_->local_bus_member();
+        bus->add_writer(topic_name_, type_name_);
+    }
     context_->register_writer(this);
 }
 
 WriterBase::~WriterBase() {
     if (context_ == nullptr) return;  // detached: the context deleted the DDS writer
+    if (local_readers_ != nullptr) context_->local_bus()->remove_writer(topic_name_, type_name_);
     context_->unregister_writer(this);
     delete_writer(context_->publisher(), writer_);
 }
 
 void WriterBase::detach() {
+    if (local_readers_ != nullptr) context_->local_bus()->remove_writer(topic_name_, type_name_);
     delete_writer(context_->publisher(), writer_);
     writer_ = nullptr;
     context_ = nullptr;
+    local_readers_ = nullptr;
 }
 
 bool WriterBase::write_raw(void* sample) {
@@ -175,8 +197,19 @@ bool WriterBase::write_raw(void* sample) {
                                      writer_->get_type().get_type_name() + ")");
         }
     }
-    undelivered_.store(true);
-    if (!writer_->write(sample)) return false;
+    if (local_readers_ != nullptr) {
+        // In-process delivery (LocalBus, dds_context.h): the bus's readers hold
+        // the sample now. DDS carries it only while a reader off the bus
+        // listens: another process's (an observer), or a raw reader here.
+        for (ReaderBase* reader : *local_readers_) reader->deliver_local(sample, local_member_);
+        if (listener_.off_bus.load(std::memory_order_relaxed) > 0 || *member_dds_readers_ > 0) {
+            undelivered_.store(true);
+            if (!writer_->write(sample)) return false;
+        }
+    } else {
+        undelivered_.store(true);
+        if (!writer_->write(sample)) return false;
+    }
     written_.fetch_add(1);
     if (counts_as_output_) context_->note_published();
     return true;
@@ -191,7 +224,10 @@ bool WriterBase::wait_delivered(std::chrono::milliseconds timeout) {
     return true;
 }
 
-void ReaderBase::MatchListener::on_data_available(dds::DataReader*) { context.notify_data_arrived(); }
+void ReaderBase::MatchListener::on_data_available(dds::DataReader*) {
+    owner.dds_pending_.store(true);
+    context.notify_data_arrived();
+}
 
 void ReaderBase::MatchListener::on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) {
     matched.store(status.current_count);
@@ -199,12 +235,19 @@ void ReaderBase::MatchListener::on_subscription_matched(dds::DataReader*, const 
 }
 
 void WriterBase::MatchListener::on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) {
+    // Before the matched count: whoever sees the match counted sees it here too.
+    if (const std::shared_ptr<LocalBus>& bus = context.local_bus(); bus && status.current_count_change != 0) {
+        // The reader's GUID: its first 12 bytes are its participant's prefix.
+        if (!bus->is_member(hex_prefix(status.last_subscription_handle.value, kPrefixBytes))) {
+            off_bus.fetch_add(status.current_count_change);
+        }
+    }
     matched.store(status.current_count);
     context.notify_matching_changed();
 }
 
 ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic)
-    : context_(&context), topic_name_(std::move(topic_name)), listener_(context) {
+    : context_(&context), topic_name_(std::move(topic_name)), type_name_(topic->get_type_name()), listener_(context, *this) {
     const bool large = max_serialized_size(context_->participant(), *topic) > kLargeTypeBytes;
     dds::DataReaderQos qos =
         project_reader_qos(context_->subscriber(), large ? ReliabilityTimers::prompt_repair : context_->reliability_timers());
@@ -212,19 +255,48 @@ ReaderBase::ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* 
     reader_ = context_->subscriber().create_datareader(
         topic, qos, &listener_, dds::StatusMask::subscription_matched() << dds::StatusMask::data_available());
     if (reader_ == nullptr) throw std::runtime_error("cannot create DDS reader on topic " + topic_name_);
+    if (context_->local_bus()) {
+        // Off the bus until a typed reader joins it (join_local_bus).
+        bus_ = context_->local_bus();
+        bus_->add_dds_reader(topic_name_);
+        counted_off_bus_ = true;
+    }
     context_->register_reader(this);
 }
 
 ReaderBase::~ReaderBase() {
+    leave_local_bus();
+    if (counted_off_bus_) bus_->remove_dds_reader(topic_name_);
     if (context_ == nullptr) return;  // detached: the context deleted the DDS reader
     context_->unregister_reader(this);
     context_->subscriber().delete_datareader(reader_);
 }
 
 void ReaderBase::detach() {
+    leave_local_bus();
+    if (counted_off_bus_) bus_->remove_dds_reader(topic_name_);
+    counted_off_bus_ = false;
     context_->subscriber().delete_datareader(reader_);
     reader_ = nullptr;
     context_ = nullptr;
+}
+
+void ReaderBase::join_local_bus() {
+    if (!counted_off_bus_) return;  // no bus
+    bus_->remove_dds_reader(topic_name_);
+    counted_off_bus_ = false;
+    bus_->add_reader(topic_name_, type_name_, this);
+    on_bus_ = true;
+}
+
+void ReaderBase::leave_local_bus() {
+    if (!on_bus_) return;
+    bus_->remove_reader(this);
+    on_bus_ = false;  // bus_ stays: queued samples still name their writers by it
+}
+
+void ReaderBase::deliver_local(const void*, std::uint32_t) {
+    throw std::logic_error("in-process delivery to a reader of " + topic_name_ + " that is not on the bus");
 }
 
 bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
@@ -236,16 +308,6 @@ bool ReaderBase::wait_for_data(std::chrono::milliseconds timeout) {
 
 namespace {
 
-std::string hex_prefix(const unsigned char* bytes, std::size_t size) {
-    static const char* digits = "0123456789abcdef";
-    std::string hex;
-    for (std::size_t i = 0; i < size; ++i) {
-        hex += digits[bytes[i] >> 4];
-        hex += digits[bytes[i] & 0xf];
-    }
-    return hex;
-}
-
 std::string prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
     return hex_prefix(prefix.value, eprosima::fastrtps::rtps::GuidPrefix_t::size);
 }
@@ -254,16 +316,25 @@ std::string prefix_of(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
 
 bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
     if (reader_ == nullptr) return false;
+    if (on_bus_) {
+        // Fast DDS is asked only after its listener said something came; the
+        // flag is cleared before asking, so a sample arriving meanwhile sets it again.
+        if (!dds_pending_.load()) return false;
+        dds_pending_.store(false);
+    }
     dds::SampleInfo info;
     while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data) {
-            taken_.fetch_add(1);
-            if (writer_prefix != nullptr) {
-                // The publication handle is the writer's GUID: its first 12 bytes are its participant's prefix.
-                unsigned char bytes[eprosima::fastrtps::rtps::GuidPrefix_t::size];
-                for (std::size_t i = 0; i < sizeof bytes; ++i) bytes[i] = info.publication_handle.value[i];
-                *writer_prefix = hex_prefix(bytes, sizeof bytes);
+            // The publication handle is the writer's GUID: its first 12 bytes are its participant's prefix.
+            unsigned char bytes[kPrefixBytes];
+            for (std::size_t i = 0; i < sizeof bytes; ++i) bytes[i] = info.publication_handle.value[i];
+            if (on_bus_) {
+                // A bus sample that also went over DDS (for an observer) was handed over already.
+                if (bus_->is_member(hex_prefix(bytes, sizeof bytes))) continue;
+                dds_pending_.store(true);  // more may wait behind this one
             }
+            taken_.fetch_add(1);
+            if (writer_prefix != nullptr) *writer_prefix = hex_prefix(bytes, sizeof bytes);
             return true;
         }
         // Dispose / unregister notifications are not samples; nobody writes them here.
@@ -272,6 +343,9 @@ bool ReaderBase::take_raw(void* sample, std::string* writer_prefix) {
 }
 
 std::uint64_t ReaderBase::received_count() const {
+    // On a bus: every bus sample was counted as it was handed over; what came
+    // over DDS from outside the bus counts once taken.
+    if (on_bus_) return local_received_.load(std::memory_order_relaxed) + taken_.load();
     // Read the unread count first: a sample taken in between is then counted in
     // neither, never twice (the count can only be low, and the waiter re-checks).
     const std::uint64_t unread = reader_ != nullptr ? reader_->get_unread_count() : 0;
@@ -350,6 +424,49 @@ DdsContext::~DdsContext() {
     for (WriterBase* writer : writers) writer->detach();
     for (ReaderBase* reader : readers) reader->detach();
     delete_participant(participant_);
+}
+
+void DdsContext::join_local_bus(std::shared_ptr<LocalBus> bus) {
+    {
+        std::lock_guard lock(registry_mutex_);
+        if (!writers_.empty() || !readers_.empty()) {
+            throw std::logic_error("DdsContext::join_local_bus after endpoints were made (participant " + guid_prefix_ + ")");
+        }
+    }
+    bus_member_ = bus->add_member(guid_prefix_);
+    bus_ = std::move(bus);
+}
+
+bool DdsContext::all_readers_on_local_bus() const {
+    if (!bus_) return false;
+    std::lock_guard lock(registry_mutex_);
+    return std::all_of(readers_.begin(), readers_.end(), [](const ReaderBase* reader) { return reader->on_local_bus(); });
+}
+
+std::uint32_t LocalBus::add_member(const std::string& guid_prefix) {
+    members_.push_back(guid_prefix);
+    return static_cast<std::uint32_t>(members_.size() - 1);
+}
+
+bool LocalBus::is_member(const std::string& guid_prefix) const {
+    return std::find(members_.begin(), members_.end(), guid_prefix) != members_.end();
+}
+
+const std::vector<ReaderBase*>& LocalBus::readers_of(const std::string& topic, const std::string& type) {
+    return readers_[{topic, type}];
+}
+
+void LocalBus::add_reader(const std::string& topic, const std::string& type, ReaderBase* reader) {
+    readers_[{topic, type}].push_back(reader);
+}
+
+bool LocalBus::has_writer(const std::string& topic, const std::string& type) const {
+    const auto it = writers_.find({topic, type});
+    return it != writers_.end() && it->second > 0;
+}
+
+void LocalBus::remove_reader(ReaderBase* reader) {
+    for (auto& [key, readers] : readers_) readers.erase(std::remove(readers.begin(), readers.end(), reader), readers.end());
 }
 
 dds::Topic* DdsContext::topic_for(const std::string& name, dds::TypeSupport (*make_type)()) {

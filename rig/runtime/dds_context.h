@@ -59,6 +59,55 @@ struct DiscoveredEndpoint {
     bool removed = false;     // the endpoint went away
 };
 
+class ReaderBase;
+
+// In-process delivery (software in the loop, docs/speed.md "In-process
+// delivery"): when every node of a run lives in one process, the contexts of
+// that process share a LocalBus and a sample goes from Writer<Msg>::publish
+// straight into the queues of the typed readers of its topic and type on the
+// bus, in the order written, before publish returns. Over DDS the same
+// samples reach the same readers in the same order (reliable, keep-all, one
+// writer per topic and node, counted delivery before each step), so a node
+// cannot tell, and lockstep's counted delivery is met the moment publish
+// returns. The DDS endpoints stay: discovery still sees every endpoint (the
+// harness's role checks), and a writer also writes over DDS while a reader
+// outside the bus is matched (an observer on `--domain`, a raw reader of a
+// controller's own topic); the bus's readers drop those DDS copies of bus
+// samples and still take what writers outside the bus send (a forger's).
+// Endpoints join and leave on their context's thread before and after the
+// run; delivery runs on the lockstep's one thread, so the bus takes no lock.
+class LocalBus {
+public:
+    // A context joining the bus; returns its index (what a queued sample says of its writer).
+    std::uint32_t add_member(const std::string& guid_prefix);
+    const std::string& member_prefix(std::uint32_t member) const { return members_.at(member); }
+    // Whether a GUID prefix (hex) is a context on this bus.
+    bool is_member(const std::string& guid_prefix) const;
+    // The bus's typed readers of a topic and type. The list's address stays
+    // the same while the bus lives (a writer keeps it).
+    const std::vector<ReaderBase*>& readers_of(const std::string& topic, const std::string& type);
+    void add_reader(const std::string& topic, const std::string& type, ReaderBase* reader);
+    void remove_reader(ReaderBase* reader);
+    // Readers of the bus's contexts that are not on it (a raw reader of a
+    // controller's own topic): a writer of their topic also writes over DDS.
+    // The count's address stays the same while the bus lives.
+    const int& dds_readers_of(const std::string& topic) { return dds_readers_[topic]; }
+    void add_dds_reader(const std::string& topic) { ++dds_readers_[topic]; }
+    void remove_dds_reader(const std::string& topic) { --dds_readers_[topic]; }
+    // Writers on the bus per topic and type: a reader of the bus with one
+    // needs no DDS match to be reached.
+    void add_writer(const std::string& topic, const std::string& type) { ++writers_[{topic, type}]; }
+    void remove_writer(const std::string& topic, const std::string& type) { --writers_[{topic, type}]; }
+    bool has_writer(const std::string& topic, const std::string& type) const;
+
+private:
+    std::vector<std::string> members_;
+    // std::map: a node's address stays the same while the bus lives.
+    std::map<std::pair<std::string, std::string>, std::vector<ReaderBase*>> readers_;
+    std::map<std::string, int> dds_readers_;
+    std::map<std::pair<std::string, std::string>, int> writers_;
+};
+
 // Endpoint-independent part of a writer, so the context can wait for all of them.
 class WriterBase {
 public:
@@ -90,6 +139,8 @@ private:
         explicit MatchListener(DdsContext& owner) : context(owner) {}
         DdsContext& context;
         std::atomic<int> matched{0};
+        // Matched readers of participants not on the context's LocalBus (an observer).
+        std::atomic<int> off_bus{0};
         void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& status) override;
     };
     DdsContext* context_;  // null once detached
@@ -102,6 +153,12 @@ private:
     std::uint32_t max_serialized_bytes_ = 0;
     std::atomic<bool> undelivered_{false};
     std::atomic<std::uint64_t> written_{0};
+    // In-process delivery (LocalBus): the bus's readers of this topic and
+    // type (null: the context has no bus), and this context's index on it.
+    const std::vector<ReaderBase*>* local_readers_ = nullptr;
+    const int* member_dds_readers_ = nullptr;  // LocalBus::dds_readers_of this topic
+    std::uint32_t local_member_ = 0;
+    std::string type_name_;
 };
 
 // A typed writer on one topic. Each publish() is counted by the context, which is
@@ -127,7 +184,18 @@ public:
 
     const std::string& topic_name() const { return topic_name_; }
     int matched_writers() const { return listener_.matched.load(); }
-    bool has_unread() const { return reader_ != nullptr && reader_->get_unread_count() > 0; }
+    // On a bus (LocalBus), what counts is the bus's samples: a sample a writer
+    // outside it sent (a forger's) is taken and recorded, but does not make a
+    // node due, as it never did for what the lockstep counts.
+    bool has_unread() const {
+        if (on_bus_) return local_unread_ > 0;
+        return reader_ != nullptr && reader_->get_unread_count() > 0;
+    }
+    // Whether samples of writers on its context's LocalBus reach it by hand-off.
+    bool on_local_bus() const { return on_bus_; }
+    // On the bus, and a writer on the bus writes its topic: it is reached
+    // whatever DDS discovery has matched so far.
+    bool reached_on_local_bus() const { return on_bus_ && bus_->has_writer(topic_name_, type_name_); }
     // Samples that have arrived since the reader was created (taken or not).
     std::uint64_t received_count() const;
     // Blocks (wall time) until a sample is available or the timeout passes.
@@ -137,35 +205,72 @@ protected:
     ReaderBase(DdsContext& context, std::string topic_name, dds::Topic* topic);
     // Takes one sample into `sample`; false when the history is empty. With
     // `writer_prefix`, also says whose participant wrote it (hex GUID prefix).
+    // On a bus, the DDS copies of the bus's own samples are dropped here.
     bool take_raw(void* sample, std::string* writer_prefix = nullptr);
+    // A typed reader joins its context's LocalBus, if it has one.
+    void join_local_bus();
+    // A typed reader leaves it before its queue goes (its destructor).
+    void leave_local_bus();
+    // The bus's hand-off: a copy of `sample` (of this reader's type) queued.
+    // Only typed readers join a bus; any other is never handed a sample
+    // (std::logic_error if it were).
+    virtual void deliver_local(const void* sample, std::uint32_t writer_member);
+    // Bookkeeping of the typed queue: samples queued, and taken.
+    void note_local_queued() {
+        ++local_unread_;
+        local_received_.fetch_add(1, std::memory_order_relaxed);
+    }
+    void note_local_taken(std::size_t samples) { local_unread_ -= samples; }
+    std::size_t local_unread() const { return local_unread_; }
+    const LocalBus& local_bus() const { return *bus_; }
 
 private:
     friend class DdsContext;
+    friend class WriterBase;
     // As WriterBase::detach: the context goes first; nothing arrives any more.
     void detach();
 
     struct MatchListener : dds::DataReaderListener {
-        explicit MatchListener(DdsContext& owner) : context(owner) {}
+        MatchListener(DdsContext& context_of, ReaderBase& reader) : context(context_of), owner(reader) {}
         DdsContext& context;
+        ReaderBase& owner;
         std::atomic<int> matched{0};
         void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override;
         void on_data_available(dds::DataReader*) override;
     };
     DdsContext* context_;  // null once detached
     std::string topic_name_;
+    std::string type_name_;
     MatchListener listener_;
     dds::DataReader* reader_ = nullptr;
     std::atomic<std::uint64_t> taken_{0};
+    // In-process delivery (LocalBus).
+    std::shared_ptr<LocalBus> bus_;
+    bool on_bus_ = false;
+    bool counted_off_bus_ = false;  // in the bus's dds_readers_of count
+    std::size_t local_unread_ = 0;
+    std::atomic<std::uint64_t> local_received_{0};
+    // Set by Fast DDS's listener when a DDS sample arrives: on a bus, only
+    // then does take_raw ask Fast DDS for samples.
+    std::atomic<bool> dds_pending_{false};
 };
 
 // A typed reader: take_all() returns every received sample in arrival order
 // (per-writer order is preserved by reliable DDS).
+//
+// On a LocalBus the bus's samples wait in a queue of slots that is reused
+// round after round (a slot's buffers are kept for the next sample), and come
+// out before any sample a writer outside the bus sent over DDS.
 template <class Msg>
 class Reader final : public ReaderBase {
 public:
     Reader(DdsContext& context, const std::string& topic_name);
+    ~Reader() override { leave_local_bus(); }
     std::vector<Msg> take_all() {
         std::vector<Msg> samples;
+        samples.reserve(local_unread());
+        for (std::size_t i = 0; i < local_unread(); ++i) samples.push_back(std::move(queue_[i].sample));
+        note_local_taken(local_unread());
         Msg sample;
         while (take_raw(&sample)) samples.push_back(sample);
         return samples;
@@ -173,11 +278,30 @@ public:
     // The same, each with the GUID prefix (hex) of the participant that wrote it.
     std::vector<std::pair<Msg, std::string>> take_all_with_writer() {
         std::vector<std::pair<Msg, std::string>> samples;
+        samples.reserve(local_unread());
+        for (std::size_t i = 0; i < local_unread(); ++i) {
+            samples.emplace_back(std::move(queue_[i].sample), local_bus().member_prefix(queue_[i].writer_member));
+        }
+        note_local_taken(local_unread());
         Msg sample;
         std::string writer;
         while (take_raw(&sample, &writer)) samples.emplace_back(sample, writer);
         return samples;
     }
+
+private:
+    struct Queued {
+        Msg sample;
+        std::uint32_t writer_member = 0;
+    };
+    void deliver_local(const void* sample, std::uint32_t writer_member) override {
+        const std::size_t slot = local_unread();
+        if (slot == queue_.size()) queue_.emplace_back();
+        queue_[slot].sample = *static_cast<const Msg*>(sample);
+        queue_[slot].writer_member = writer_member;
+        note_local_queued();
+    }
+    std::vector<Queued> queue_;  // the first local_unread() slots hold samples
 };
 
 // A sample of a topic whose type the rig does not know (a controller's own
@@ -198,6 +322,16 @@ public:
     DdsContext& operator=(const DdsContext&) = delete;
 
     std::uint32_t domain_id() const { return domain_id_; }
+    // In-process delivery (LocalBus): this context's endpoints hand samples to
+    // the bus's other endpoints directly. Only before any endpoint is made
+    // (std::logic_error after); contexts share a bus by joining the same one.
+    void join_local_bus(std::shared_ptr<LocalBus> bus);
+    const std::shared_ptr<LocalBus>& local_bus() const { return bus_; }
+    // Every reader of this context is reached by hand-off (on a bus, no raw
+    // reader): what was published is in the readers when publish returns,
+    // as far as writers on the bus go.
+    bool all_readers_on_local_bus() const;
+    std::uint32_t local_bus_member() const { return bus_member_; }
     // The timers every endpoint made in this context gets (a large type gets
     // prompt_repair whatever this says).
     ReliabilityTimers reliability_timers() const { return timers_; }
@@ -284,6 +418,8 @@ private:
     class DiscoveryWatch;
     std::uint32_t domain_id_;
     ReliabilityTimers timers_;
+    std::shared_ptr<LocalBus> bus_;
+    std::uint32_t bus_member_ = 0;
     std::unique_ptr<DiscoveryWatch> discovery_;  // before participant_: outlives it
     std::string guid_prefix_;
     bool secured_ = false;  // created with a DDS-Security identity (rig/runtime/dds_security.h)
@@ -324,6 +460,8 @@ Writer<Msg>::Writer(DdsContext& context, const std::string& topic_name, bool cou
 
 template <class Msg>
 Reader<Msg>::Reader(DdsContext& context, const std::string& topic_name)
-    : ReaderBase(context, topic_name, context.topic<Msg>(topic_name)) {}
+    : ReaderBase(context, topic_name, context.topic<Msg>(topic_name)) {
+    join_local_bus();
+}
 
 }  // namespace rig

@@ -108,6 +108,8 @@ void LockstepMaster::wait_in_process_matched(const Remote& remote,
     // configuration error, reported with the node's name when the bound passes.
     DdsContext& node_dds = *remote.in_process_dds;
     for (ReaderBase* reader : node_dds.readers()) {
+        // A writer on the LocalBus reaches it by hand-off (rig/runtime/dds_context.h).
+        if (reader->reached_on_local_bus()) continue;
         for (;;) {
             const std::uint64_t seen = node_dds.matching_change_count();
             if (reader->matched_writers() >= 1) break;
@@ -168,9 +170,19 @@ void LockstepMaster::start() {
         }
     }
 
+    // No process to tick and every reader reached by hand-off (software in the
+    // loop, rig/runtime/dds_context.h LocalBus): a sample is in its readers when
+    // publish returns, so counted delivery holds without counting, and no DDS
+    // match need be waited for (discovery goes on, for the role checks and
+    // observers, while time runs).
+    delivered_at_publish_ = process_remote_count() == 0 && dds_.all_readers_on_local_bus() &&
+                            std::all_of(remotes_.begin(), remotes_.end(), [](const Remote& remote) {
+                                return remote.in_process_dds->all_readers_on_local_bus();
+                            });
     // Every writer must reach every reader of its topic (local ones and the remotes
     // that said they read it) before time starts, or early samples would be lost.
     for (WriterBase* writer : dds_.writers()) {
+        if (delivered_at_publish_) break;
         if (writer == tick_writer_.get()) continue;
         int expected = 0;
         for (ReaderBase* reader : dds_.readers()) expected += reader->topic_name() == writer->topic_name();
@@ -190,6 +202,7 @@ void LockstepMaster::start() {
     // (checked above from the writer's side) and the remotes' (from here: a
     // remote only knows that one reader matched its writer, not that all did).
     for (ReaderBase* reader : dds_.readers()) {
+        if (delivered_at_publish_) break;
         if (reader == ack_reader_.get()) continue;
         int expected = 0;
         for (WriterBase* writer : dds_.writers()) expected += writer->topic_name() == reader->topic_name();
@@ -260,6 +273,14 @@ void LockstepMaster::wait_local_readers(TimeNs t) {
 }
 
 std::uint32_t LockstepMaster::tick_remotes(TimeNs t, bool shutdown) {
+    if (delivered_at_publish_) {
+        // Only in-process nodes, and nothing to count (start()): each steps as
+        // below, without the tick's counts.
+        const std::uint64_t seq = seq_++;
+        std::uint32_t published = 0;
+        for (Remote& remote : remotes_) published += step_in_process(remote, seq, t, shutdown, no_counts_);
+        return published;
+    }
     msg::ClockTick tick;
     tick.seq(seq_);
     tick.time_ns(t);
@@ -358,7 +379,7 @@ std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq,
     // Counted delivery, as a follower: everything published so far is in its
     // readers before it takes its inputs.
     const WallStopwatch waited;
-    for (;;) {
+    while (!delivered_at_publish_) {
         const auto short_topics = node_dds.wait_received(published_before, kPollSlice);
         if (short_topics.empty()) break;
         if (watchdog_) watchdog_();
@@ -370,7 +391,7 @@ std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq,
         }
     }
     node_dds.take_published_count();
-    if (!remote.activated) {
+    if (!remote.activated && !delivered_at_publish_) {
         // Its writers reach every reader of their topics before it first
         // publishes (the first tick's reader counts, lockstep.h).
         const TopicCounts readers = reader_counts();
@@ -402,7 +423,9 @@ std::uint32_t LockstepMaster::step_in_process(Remote& remote, std::uint64_t seq,
     } catch (const std::exception& error) {
         throw NodeFailure(FailureKind::node_fatal_error, remote.name, error.what());
     }
-    remote.published_counts = node_dds.written_counts();
+    // Counted for the next tick's counts and the master's readers (not
+    // needed when everything is delivered at publish).
+    if (!delivered_at_publish_) remote.published_counts = node_dds.written_counts();
     return node_dds.take_published_count();
 }
 
@@ -416,7 +439,6 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
     now_ns_ = t;
     for (TruthModel* model : truth_models_) model->advance_to(t);
 
-    std::uint32_t published_by_remotes = 0;
     for (int round = 0;; ++round) {
         if (round >= kMaxRoundsPerInstant) {
             throw NodeFailure(FailureKind::feedback_loop, "harness", "nodes kept answering each other at t=" + format_time(t) + " for " +
@@ -430,23 +452,25 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
 
         bool remote_due = false;
         for (const Remote& remote : remotes_) remote_due |= round == 0 && remote.next_wake_ns <= t;
-        published_by_remotes = 0;
         if (!remotes_.empty() && (remote_due || published_by_locals > 0)) {
             // The tick carries the published counts; each remote waits for its
             // readers to hold them before it steps.
-            published_by_remotes = tick_remotes(t, false);
+            tick_remotes(t, false);
         }
         // Local readers (the trace, local nodes) hold everything published at t,
         // here and in the remotes, before the round ends.
-        wait_local_readers(t);
+        if (!delivered_at_publish_) wait_local_readers(t);
         if (after_round_) after_round_(t, round);
         if (watchdog_) watchdog_();
-        if (published_by_remotes == 0) {
-            // Local nodes may still hold input that arrived from other local nodes.
-            bool pending = false;
-            for (const Local& local : locals_) pending |= local.node->has_unread_input();
-            if (!pending) break;
-        }
+        // Another round only for a local node with input to take: what the
+        // remotes published is in the local readers now (wait_local_readers),
+        // and a remote is ticked again at t only for what the local nodes
+        // publish. A round for the remotes' samples alone stepped no node and
+        // recorded nothing (half the rounds of a case whose controller answers
+        // every tick), so it is not run.
+        bool pending = false;
+        for (const Local& local : locals_) pending |= local.node->has_unread_input();
+        if (!pending) break;
     }
     return t;
 }

@@ -15,9 +15,15 @@
 //            wait_for_acknowledgments gives (every sample published at t is in
 //            its readers before they step), minus one handshake per writer per
 //            instant, which was 45 % of a case's wall time (docs/design.md "Time").
-//   round r>0: while the previous round published anything, nodes with unread
-//            input run again at the same t. A sample published at t is therefore
-//            seen by its readers at t; delays come only from the models.
+//   round r>0: while a local node holds unread input (what the previous
+//            round published), the nodes with unread input run again at the
+//            same t, and the remotes are ticked again if the local nodes
+//            published. A sample published at t is therefore seen by its
+//            readers at t; delays come only from the models. A round in which
+//            no node would step is not run (rounds only when needed).
+//   In software in the loop (every node in the master's process, on one
+//   LocalBus, rig/runtime/dds_context.h) a sample is in its readers when
+//   publish returns: the counts are neither made nor waited for.
 // Then the master jumps to the earliest next_wake of all nodes: idle simulated
 // time costs nothing. Tick 0 is a hello, sent again every 0.2 s of wall time
 // until every remote answered (a reader matched after it was written may never
@@ -180,6 +186,12 @@ private:
     std::function<void(const std::vector<HelloTopics>&)> after_hello_;
     std::uint64_t seq_ = 0;
     TimeNs now_ns_ = 0;
+    // Set by start(): no process remote, and every reader here and in the
+    // in-process nodes is on a LocalBus (rig/runtime/dds_context.h), so what
+    // is published is in its readers when publish returns: no counts are
+    // made, sent or waited for.
+    bool delivered_at_publish_ = false;
+    const TopicCounts no_counts_;
     bool started_ = false;
     bool shut_down_ = false;
 };

@@ -58,8 +58,9 @@ struct NodePluginCaseText {
 // The plugin's and the rig's copies of the runtime's classes must agree on
 // layout: the number goes up when one changes within a rig version (2: the
 // writers' match listener holds its context, rig/runtime/dds_context.h; 3: a
-// Node may report its own emissions, two more virtual functions, rig/runtime/node.h).
-#define RIG_NODE_PLUGIN_ABI_STRING "rig-node-plugin/3 rig/" RIG_VERSION_STRING " gcc/" __VERSION__
+// Node may report its own emissions, two more virtual functions, rig/runtime/node.h;
+// 4: readers and writers carry in-process delivery, rig/runtime/dds_context.h LocalBus).
+#define RIG_NODE_PLUGIN_ABI_STRING "rig-node-plugin/4 rig/" RIG_VERSION_STRING " gcc/" __VERSION__
 inline constexpr const char* kNodePluginAbi = RIG_NODE_PLUGIN_ABI_STRING;
 
 // Symbol names the harness looks up.
