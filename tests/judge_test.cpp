@@ -35,12 +35,15 @@
 #include "harness/systems/systems.h"
 #include "harness/trace/topic_roles.h"
 #include "harness/trace/trace_file.h"
+#include "harness/trace/trace_json.h"
+#include "harness/trace/trace_reader.h"
 #include "idl/topics.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 using rig::TimeNs;
+namespace msg = rig::msg;
 using namespace rig::harness;
 
 constexpr TimeNs kMs = 1'000'000;
@@ -438,19 +441,22 @@ TEST(TraceFile, AWriteThatFailedOnTheRunsThreadIsNamedWhenFinishRefuses) {
     }
 }
 
+// The trace judged again after `sql` changed it.
+CaseResult judged_after_editing(HandMadeTrace& made, const char* sql) {
+    sqlite3* db = nullptr;
+    EXPECT_EQ(sqlite3_open(made.path().c_str(), &db), SQLITE_OK);
+    EXPECT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, nullptr), SQLITE_OK) << sql;
+    sqlite3_close(db);
+    return made.judged().result;
+}
+
 TEST(Judge, ATraceChangedAfterItsRunIsNotJudgedAsTheRuns) {
     HandMadeTrace made("edited", continuation_plan());
     made.drive();
     made.finish();
     EXPECT_EQ(made.judged().result.error, "");
-    sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open(made.path().c_str(), &db), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(db,
-                           "UPDATE samples SET json = replace(json, '-25.0', '-24.0') WHERE rowid = 1",
-                           nullptr, nullptr, nullptr),
-              SQLITE_OK);
-    sqlite3_close(db);
-    const CaseResult result = made.judged().result;
+    const CaseResult result =
+        judged_after_editing(made, "UPDATE samples SET json = replace(json, '-25.0', '-24.0') WHERE rowid = 1");
     EXPECT_EQ(result.error_kind, "harness_error");
     EXPECT_NE(result.error.find("changed after the run"), std::string::npos) << result.error;
 }
@@ -477,6 +483,131 @@ TEST(Judge, WhatIsNotATraceIsRefusedNamingIt) {
         ADD_FAILURE() << "a format-1 trace was read";
     } catch (const std::runtime_error& error) {
         EXPECT_NE(std::string(error.what()).find("trace format 1"), std::string::npos) << error.what();
+    }
+}
+
+// Samples recorded from their IDL type are stored as CDR bytes beside the JSON
+// text the writer renders from them (harness/trace/trace_cdr.h). The text, and
+// so the digest, is what a trace written as text has; the judge reads values
+// decoded from the bytes; the views people query still read the text.
+msg::HydraulicsTruth hydraulics_at(int i) {
+    msg::HydraulicsTruth sample;
+    sample.time_ns(i * 10 * kMs);
+    sample.main_flow_l_min(20.0 + i / 3.0);
+    sample.valve_opening_pct(i % 7 == 0 ? std::nan("") : 1e-7 * i);
+    sample.sections_spraying_mask(static_cast<std::uint16_t>(i % 8));
+    sample.nozzles_spraying(static_cast<std::uint16_t>(i % 25));
+    return sample;
+}
+
+std::vector<std::vector<std::string>> query(const fs::path& file, const std::string& sql) {
+    sqlite3* db = nullptr;
+    EXPECT_EQ(sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr), SQLITE_OK);
+    std::vector<std::vector<std::string>> rows;
+    const auto collect = [](void* out, int columns, char** values, char**) {
+        auto& table = *static_cast<std::vector<std::vector<std::string>>*>(out);
+        table.emplace_back();
+        for (int i = 0; i < columns; ++i) table.back().push_back(values[i] != nullptr ? values[i] : "NULL");
+        return 0;
+    };
+    EXPECT_EQ(sqlite3_exec(db, sql.c_str(), collect, &rows, nullptr), SQLITE_OK) << sql;
+    sqlite3_close(db);
+    return rows;
+}
+
+TEST(TraceBytes, SamplesStoredAsBytesKeepTheTextTracesDigestAndAreReadAsItsValues) {
+    const fs::path dir = rig::testing::fresh_dir("trace-bytes");
+    const std::string topic = rig::topics::kHydraulicsTruth;
+    std::string typed_sha256, text_sha256;
+    {
+        TraceFile typed(dir / "typed.sqlite");
+        const std::uint32_t slot = typed.topic_slot(topic, &sample_codec<msg::HydraulicsTruth>());
+        TraceFile text(dir / "text.sqlite");
+        for (int i = 0; i < 5000; ++i) {
+            typed.append_sample(i * 10 * kMs, i, slot, hydraulics_at(i));
+            text.append_text(i * 10 * kMs, i, topic, to_json_text(hydraulics_at(i)));
+        }
+        typed_sha256 = typed.finish(TraceOutcome{"completed", "", "", 50 * kS});
+        text_sha256 = text.finish(TraceOutcome{"completed", "", "", 50 * kS});
+    }
+    EXPECT_EQ(typed_sha256, text_sha256);
+    EXPECT_EQ(query(dir / "typed.sqlite", "select json from samples order by rowid"),
+              query(dir / "text.sqlite", "select json from samples order by rowid"));
+
+    const RecordedTrace trace = read_trace(dir / "typed.sqlite");
+    EXPECT_EQ(trace.meta.at("trace_format"), "3");
+    EXPECT_EQ(trace.recomputed_sha256, typed_sha256);
+    EXPECT_EQ(trace.recomputed_cdr_sha256, trace.meta.at("cdr_sha256"));
+    EXPECT_EQ(trace.sample_types.at(topic), "rig::msg::HydraulicsTruth");
+    const std::vector<RecordedSample>& samples = trace.samples(topic);
+    ASSERT_EQ(samples.size(), 5000u);
+    for (int i = 0; i < 5000; ++i) {
+        ASSERT_FALSE(trace.rows.at(topic)[static_cast<std::size_t>(i)].cdr.empty());
+        ASSERT_EQ(samples[static_cast<std::size_t>(i)].json, nlohmann::json::parse(to_json_text(hydraulics_at(i)))) << i;
+        ASSERT_EQ(samples[static_cast<std::size_t>(i)].round, i);
+    }
+    // The views of docs/trace-format.md read the text, as before.
+    const auto rows = query(dir / "typed.sqlite",
+                            "select t_s, main_flow_l_min, valve_opening_pct, nozzles_spraying from hydraulics "
+                            "where t_s > 40 limit 20");
+    ASSERT_EQ(rows.size(), 20u);
+    EXPECT_EQ(rows[0], (std::vector<std::string>{"40.01", "1353.66666666667", "0.0004001", "1"}));
+    EXPECT_EQ(rows[3][2], "NULL");  // i = 4004, a multiple of 7: not a number, stored as null
+}
+
+TEST(TraceBytes, ChangedBytesAreNotJudgedAsTheRuns) {
+    HandMadeTrace made("edited-bytes", continuation_plan());
+    made.drive();
+    const std::uint32_t slot =
+        made.trace().topic_slot(rig::topics::kHydraulicsTruth, &sample_codec<msg::HydraulicsTruth>());
+    for (int i = 0; i < 100; ++i) made.trace().append_sample(25 * kS + i * 10 * kMs, 0, slot, hydraulics_at(i));
+    made.finish();
+    EXPECT_EQ(made.judged().result.error, "");
+    const CaseResult result = judged_after_editing(made,
+                                                   "UPDATE samples SET cdr = zeroblob(length(cdr)) WHERE rowid = "
+                                                   "(SELECT min(rowid) FROM samples WHERE cdr IS NOT NULL)");
+    EXPECT_EQ(result.error_kind, "harness_error");
+    EXPECT_NE(result.error.find("samples' bytes give digest"), std::string::npos) << result.error;
+}
+
+// A rig killed with SIGKILL mid-run leaves its trace readable up to its last
+// committed batch, bytes and all. In a child process, killed once it has
+// written more than two batches (set_meta waits for the writer thread).
+TEST(TraceBytes, ATraceKilledMidRunIsReadableUpToItsLastBatch) {
+    const fs::path dir = rig::testing::fresh_dir("trace-killed");
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    ASSERT_NE(child, -1);
+    if (child == 0) {
+        ::close(ready[0]);
+        TraceFile trace(dir / "trace.sqlite");
+        const std::uint32_t slot =
+            trace.topic_slot(rig::topics::kHydraulicsTruth, &sample_codec<msg::HydraulicsTruth>());
+        for (int i = 0; i < 10000; ++i) trace.append_sample(i * 10 * kMs, 0, slot, hydraulics_at(i));
+        trace.set_meta("written", "10000");
+        const char byte = 'k';
+        if (::write(ready[1], &byte, 1) != 1) ::_exit(1);
+        for (;;) ::pause();
+    }
+    ::close(ready[1]);
+    char byte = 0;
+    ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+    ::close(ready[0]);
+    ASSERT_EQ(::kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "status " << status;
+
+    const RecordedTrace trace = read_trace(dir / "trace.sqlite");
+    EXPECT_EQ(trace.meta.at("outcome"), "running");
+    const std::vector<RecordedSample>& samples = trace.samples(rig::topics::kHydraulicsTruth);
+    // Whole batches only: the open one died with the rig.
+    ASSERT_GE(samples.size(), 4096u);
+    EXPECT_LT(samples.size(), 10000u);
+    EXPECT_EQ(samples.size() % 4096, 0u);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        ASSERT_EQ(samples[i].json, nlohmann::json::parse(to_json_text(hydraulics_at(static_cast<int>(i))))) << i;
     }
 }
 

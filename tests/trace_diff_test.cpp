@@ -14,7 +14,7 @@ using namespace rig::harness;
 class Rows {
 public:
     Rows& add(const std::string& topic, rig::TimeNs t_ns, const std::string& json, int round = 0) {
-        rows_[topic].push_back(TraceRow{t_ns, round, ++rowid_, json});
+        rows_[topic].push_back(TraceRow{t_ns, round, ++rowid_, json, {}});
         return *this;
     }
     const TopicRows& rows() const { return rows_; }

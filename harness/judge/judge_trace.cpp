@@ -152,6 +152,14 @@ CaseRun judge_trace(const RecordedTrace& trace, const SystemJudge& system) {
         result.error = "trace " + trace.file.string() + ": its rows give digest " + trace.recomputed_sha256 +
                        ", not the " + recorded_sha256 + " recorded when it was written (changed after the run?)";
     }
+    // The same for the samples' bytes, which are what the judge reads (format 3).
+    const std::string recorded_cdr_sha256 = trace.meta_or("cdr_sha256");
+    if (result.error.empty() && !recorded_cdr_sha256.empty() && recorded_cdr_sha256 != trace.recomputed_cdr_sha256) {
+        result.error_kind = "harness_error";
+        result.error = "trace " + trace.file.string() + ": its samples' bytes give digest " +
+                       trace.recomputed_cdr_sha256 + ", not the " + recorded_cdr_sha256 +
+                       " recorded when it was written (changed after the run?)";
+    }
     const std::string outcome = trace.meta_or("outcome", "running");
     if (outcome != "completed" && result.error.empty()) {
         result.error_kind = trace.meta_or("error_kind", "interrupted");

@@ -3,7 +3,10 @@
 // only input. TraceFile writes one; TraceRecorder (harness/trace/trace_recorder.h)
 // feeds it from DDS during a run, and tests write hand-made traces with it to
 // judge them (harness/judge/judge_trace.h) without any DDS.
-//   samples(t_ns, round, topic, json)   every sample, in delivery order
+//   samples(t_ns, round, topic, json, cdr)  every sample, in delivery order:
+//                                       its JSON text, and its CDR bytes when
+//                                       recorded from its IDL type
+//   sample_types(topic, type)           the IDL type of each topic's bytes
 //   deposition, landing_edges           the spray on the ground (plant truth)
 //   discovery                           endpoints other participants created
 //   foreign_samples                     truth/device samples others wrote (forged)
@@ -18,15 +21,15 @@
 // mid-run leaves a readable file up to the last batch; finish() writes the
 // outcome and the digest into meta and folds the log back into the one file.
 //
-// Samples are written off the lockstep round's critical path: append() queues
-// the row and a writer thread of the file's own serializes it, digests it and
-// inserts it, in the order queued (so the digest is the same). Every other call
+// Samples are written off the lockstep round's critical path: append_sample()
+// queues the sample's CDR bytes (harness/trace/trace_cdr.h; no text on the
+// loop) and a writer thread of the file's own renders its JSON text from them,
+// digests it and inserts both, in the order queued (so the digest is the same). Every other call
 // first waits for the queue to drain, so the file is only ever touched by one
 // thread at a time; all calls come from the thread that runs the case. A write
 // that fails (a full disk) is reported by the next call, naming the file.
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <filesystem>
 #include <mutex>
 #include <string>
@@ -36,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/trace/sha256.h"
+#include "harness/trace/trace_cdr.h"
 #include "rig/runtime/clock.h"
 #include "rig/runtime/dds_context.h"
 
@@ -45,8 +49,11 @@ struct sqlite3_stmt;
 namespace rig::harness {
 
 // Version of the trace layout (meta key `trace_format`); `rig judge` refuses
-// traces it does not know how to read.
-inline constexpr int kTraceFormat = 2;
+// traces it does not know how to read. Format 3 added the samples' CDR bytes
+// (samples.cdr, sample_types, meta cdr_sha256); format 2 traces, text only,
+// are still read and judged (their digest is the same kind).
+inline constexpr int kTraceFormat = 3;
+inline constexpr int kOldestTraceFormatRead = 2;
 
 // How a case's run ended, for meta (keys `outcome`, `error_kind`, `error`, `end_ns`).
 struct TraceOutcome {
@@ -61,6 +68,11 @@ struct TraceOutcome {
 std::string sample_digest_line(TimeNs t, int round, const std::string& topic, const std::string& json_text);
 std::string deposition_digest_line(int pass, std::size_t row, int nozzle, double dose_ul_cm2);
 std::string landing_digest_line(TimeNs t, bool landing);
+// What meta `cdr_sha256` is taken over for one sample stored as bytes: the line
+// "t_ns round topic size\n", then the bytes. It shows a changed `cdr` column as
+// trace_sha256 shows a changed `json` one (the judge reads the bytes).
+void add_cdr_digest(Sha256& digest, TimeNs t, int round, const std::string& topic, const unsigned char* cdr,
+                    std::size_t size);
 
 // Spray on the ground for the `deposition` table (seed 000's grid along the
 // track, harness/systems/breakpoint): its layout (meta `deposition_grid`) and
@@ -96,6 +108,17 @@ public:
 
     const std::filesystem::path& path() const { return file_; }
     void set_meta(const std::string& key, const std::string& value);
+    // Rows of a topic name it by its slot. A topic with a codec stores its
+    // samples as bytes too (append_sample), its type in `sample_types`; one
+    // without takes only JSON text (append_text, append). A topic has one type:
+    // another codec for it throws std::logic_error.
+    std::uint32_t topic_slot(const std::string& topic, const SampleCodec* codec = nullptr);
+    // A sample of a topic whose slot has `Msg`'s codec. Only its CDR bytes are
+    // made here; the writer thread renders its JSON text.
+    template <class Msg>
+    void append_sample(TimeNs t, int round, std::uint32_t slot, const Msg& sample) {
+        append_bytes(t, round, slot, &sample_codec<Msg>(), &sample);
+    }
     // A sample as JSON text, exactly as nlohmann::json::dump() writes it (the
     // digest is taken over it; harness/trace/trace_json.h writes it so).
     void append_text(TimeNs t, int round, const std::string& topic, std::string json_text);
@@ -122,14 +145,25 @@ private:
     struct PendingRow {
         TimeNs t = 0;
         int round = 0;
-        std::string topic;
+        std::uint32_t slot = 0;
+        bool binary = false;          // CDR bytes in the queue's bytes, else json_text
+        std::uint32_t cdr_size = 0;
+        std::size_t cdr_offset = 0;
         std::string json_text;
     };
+    struct Topic {
+        std::string name;
+        const SampleCodec* codec = nullptr;
+    };
+    void append_bytes(TimeNs t, int round, std::uint32_t slot, const SampleCodec* codec, const void* sample);
+    // Waits for room in the queue (under queue_mutex_); throws the writer's error.
+    void wait_for_room(std::unique_lock<std::mutex>& lock);
     // Records the first SQLite error (see first_error_), then throws it naming the file.
     [[noreturn]] void fail(const std::string& sqlite_error);
     void exec(const char* sql);
     void digest(const std::string& canonical);
-    void write_row(const PendingRow& row);  // on the writer thread
+    // On the writer thread; `bytes` holds binary rows' CDR.
+    void write_row(const PendingRow& row, const std::vector<unsigned char>& bytes);
     void writer_loop();
     // Until every queued row is written; throws the writer's error, if any.
     void sync();
@@ -139,10 +173,14 @@ private:
     sqlite3* db_ = nullptr;
     sqlite3_stmt* insert_ = nullptr;
     Sha256 digest_;
+    Sha256 cdr_digest_;
+    // Slot -> topic; grown only while the writer thread is idle (after sync()).
+    std::vector<Topic> topics_;
     std::uint64_t rows_ = 0;
     std::uint64_t rows_in_batch_ = 0;
     TimeNs last_t_ns_ = 0;
     std::string digest_text_;  // the digest, once computed (finish may be retried)
+    std::string cdr_digest_text_;
     std::string sha256_;       // set once the file is closed
 
     // The writer thread and its queue (bounded: a slow disk slows the run down
@@ -150,7 +188,8 @@ private:
     std::mutex queue_mutex_;
     std::condition_variable queued_;   // rows to write, or stop
     std::condition_variable drained_;  // the queue emptied, or room in it
-    std::deque<PendingRow> queue_;
+    std::vector<PendingRow> queue_;
+    std::vector<unsigned char> queue_bytes_;  // the queued rows' CDR, back to back
     bool writing_ = false;             // the writer holds rows taken off the queue
     bool stopping_ = false;
     bool flush_ = false;               // sync() waits: write whatever is queued

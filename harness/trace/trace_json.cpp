@@ -342,6 +342,60 @@ private:
     std::string values_;
 };
 
+// One JSON object built as a value, field by field: what nlohmann::json::parse
+// gives for ObjectText's text, without the text. Numbers take the kind parsing
+// gives them: a finite floating-point value a double (its text always has a
+// '.' or an exponent), an integer unsigned unless negative, a non-finite value null.
+class ObjectValue {
+public:
+    void operator()(std::string_view key, bool value) { object_[std::string(key)] = value; }
+    void operator()(std::string_view key, const char* value) { object_[std::string(key)] = value; }
+    void operator()(std::string_view key, const std::string& value) { object_[std::string(key)] = value; }
+    template <class Number, std::enable_if_t<std::is_arithmetic_v<Number> && !std::is_same_v<Number, bool>, int> = 0>
+    void operator()(std::string_view key, Number value) {
+        object_[std::string(key)] = number(value);
+    }
+    template <class Element>
+    void operator()(std::string_view key, const std::vector<Element>& elements) {
+        nlohmann::json array = nlohmann::json::array();
+        for (const Element& element : elements) {
+            if constexpr (std::is_arithmetic_v<Element>) {
+                array.push_back(number(element));
+            } else {
+                ObjectValue object;
+                fields(element, object);
+                array.push_back(object.take());
+            }
+        }
+        object_[std::string(key)] = std::move(array);
+    }
+    nlohmann::json take() { return std::move(object_); }
+
+private:
+    template <class Number>
+    static nlohmann::json number(Number value) {
+        if constexpr (std::is_floating_point_v<Number>) {
+            const double as_double = static_cast<double>(value);
+            if (!std::isfinite(as_double)) return nullptr;
+            return as_double;
+        } else if constexpr (std::is_signed_v<Number>) {
+            if (value < 0) return static_cast<std::int64_t>(value);
+            return static_cast<std::uint64_t>(value);
+        } else {
+            return static_cast<std::uint64_t>(value);
+        }
+    }
+
+    nlohmann::json object_ = nlohmann::json::object();
+};
+
+template <class Sample>
+nlohmann::json object_value(const Sample& sample) {
+    ObjectValue out;
+    fields(sample, out);
+    return out.take();
+}
+
 template <class Sample>
 std::string object_text(const Sample& sample) {
     ObjectText out;
@@ -369,6 +423,11 @@ std::string to_json_text(const msg::Vehicle2dTruth& sample) { return object_text
 std::string to_json_text(const msg::NozzlesTruth& sample) { return object_text(sample); }
 std::string to_json_text(const msg::VisionReport& sample) { return object_text(sample); }
 std::string to_json_text(const msg::CameraViewTruth& sample) { return object_text(sample); }
+
+#define RIG_DEFINE_TO_JSON_VALUE(Type) \
+    nlohmann::json to_json_value(const msg::Type& sample) { return object_value(sample); }
+RIG_TRACE_RECORDED_TYPES(RIG_DEFINE_TO_JSON_VALUE)
+#undef RIG_DEFINE_TO_JSON_VALUE
 
 std::string cdr_hex_json_text(const std::vector<unsigned char>& bytes) {
     static const char* digits = "0123456789abcdef";

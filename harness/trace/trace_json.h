@@ -11,7 +11,16 @@
 // tests/trace_json_test.cpp checks that for every type.
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "msg_traits.h"
+
+// Every type the trace records as bytes (harness/trace/trace_cdr.h), for lists over them.
+#define RIG_TRACE_RECORDED_TYPES(X)                                                                             \
+    X(NmeaSentence) X(EncoderCount) X(FlowMeterCount) X(AnalogInput) X(SwitchLevel) X(BallValveRelays)         \
+        X(SectionValves) X(UnloadingValve) X(HydraulicsTruth) X(ControllerStatus) X(BreakpointEvent)            \
+            X(VehicleTruth) X(SerialLine) X(NozzlePwm) X(Vehicle2dTruth) X(NozzlesTruth) X(VisionReport)        \
+                X(CameraViewTruth)
 
 namespace rig::harness {
 
@@ -37,6 +46,12 @@ std::string to_json_text(const msg::NozzlesTruth& sample);
 // each by its SHA-256, and the run renders them again for the report).
 std::string to_json_text(const msg::VisionReport& sample);
 std::string to_json_text(const msg::CameraViewTruth& sample);
+// The same sample as a JSON value, built from its fields with no text between:
+// equal, number kinds included (unsigned for a non-negative integer, null for a
+// non-finite number), to parsing its JSON text. The judge reads samples so.
+#define RIG_DECLARE_TO_JSON_VALUE(Type) nlohmann::json to_json_value(const msg::Type& sample);
+RIG_TRACE_RECORDED_TYPES(RIG_DECLARE_TO_JSON_VALUE)
+#undef RIG_DECLARE_TO_JSON_VALUE
 // A sample of a type the rig does not know, as its CDR bytes in hex.
 std::string cdr_hex_json_text(const std::vector<unsigned char>& bytes);
 const char* to_string(msg::BreakpointEventKind kind);

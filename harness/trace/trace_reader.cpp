@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "harness/trace/sha256.h"
+#include "harness/trace/trace_cdr.h"
 #include "harness/trace/trace_file.h"
 
 namespace rig::harness {
@@ -62,11 +63,21 @@ std::int64_t TraceReader::integer(sqlite3_stmt* row, int column) { return sqlite
 
 double TraceReader::real(sqlite3_stmt* row, int column) { return sqlite3_column_double(row, column); }
 
+std::vector<unsigned char> TraceReader::blob(sqlite3_stmt* row, int column) {
+    const auto* bytes = static_cast<const unsigned char*>(sqlite3_column_blob(row, column));
+    if (bytes == nullptr) return {};
+    return {bytes, bytes + sqlite3_column_bytes(row, column)};
+}
+
 const std::vector<RecordedSample>& RecordedTrace::samples(const std::string& topic) const {
     static const std::vector<RecordedSample> none;
     if (const auto done = parsed_.find(topic); done != parsed_.end()) return done->second;
     const auto stored = rows.find(topic);
     if (stored == rows.end()) return none;
+    const SampleCodec* codec = nullptr;
+    if (const auto type = sample_types.find(topic); type != sample_types.end()) {
+        codec = sample_codec_named(type->second);  // read_trace checked it is known
+    }
     std::vector<RecordedSample> parsed;
     parsed.reserve(stored->second.size());
     for (const TraceRow& row : stored->second) {
@@ -74,10 +85,16 @@ const std::vector<RecordedSample>& RecordedTrace::samples(const std::string& top
         sample.t_ns = row.t_ns;
         sample.round = row.round;
         try {
-            sample.json = nlohmann::json::parse(row.json_text);
-        } catch (const nlohmann::json::exception& parse_error) {
+            if (row.cdr.empty()) {
+                sample.json = nlohmann::json::parse(row.json_text);
+            } else if (codec != nullptr) {
+                sample.json = codec->json_value(row.cdr.data(), row.cdr.size());
+            } else {
+                throw std::runtime_error("CDR bytes on topic " + topic + ", which has no type in sample_types");
+            }
+        } catch (const std::exception& error) {
             throw std::runtime_error("trace " + file.string() + ": samples row " + std::to_string(row.rowid) + ": " +
-                                     parse_error.what());
+                                     error.what());
         }
         parsed.push_back(std::move(sample));
     }
@@ -95,25 +112,52 @@ RecordedTrace read_trace(const std::filesystem::path& file) {
     trace.file = file;
     reader.rows("SELECT key, value FROM meta",
                 [&](sqlite3_stmt* row) { trace.meta[TraceReader::text(row, 0)] = TraceReader::text(row, 1); });
+    // Format 2 (text only) is read as it always was; format 3 adds the bytes.
     const auto format = trace.meta.find("trace_format");
-    if (format == trace.meta.end() || format->second != std::to_string(kTraceFormat)) {
+    int format_number = 0;
+    for (int known = kOldestTraceFormatRead; known <= kTraceFormat; ++known) {
+        if (format != trace.meta.end() && format->second == std::to_string(known)) format_number = known;
+    }
+    if (format_number == 0) {
         throw std::runtime_error("trace " + file.string() + ": trace format " +
                                  (format == trace.meta.end() ? std::string("unknown") : format->second) +
-                                 ", this rig reads format " + std::to_string(kTraceFormat) + " (run the case again)");
+                                 ", this rig reads formats " + std::to_string(kOldestTraceFormatRead) + " to " +
+                                 std::to_string(kTraceFormat) + " (run the case again)");
+    }
+    const bool with_bytes = format_number >= 3;
+    if (with_bytes) {
+        reader.rows("SELECT topic, type FROM sample_types", [&](sqlite3_stmt* row) {
+            const std::string topic = TraceReader::text(row, 0);
+            const std::string type = TraceReader::text(row, 1);
+            if (sample_codec_named(type) == nullptr) {
+                throw std::runtime_error("trace " + file.string() + ": sample_types gives topic " + topic +
+                                         " the type " + type + ", which this rig does not know");
+            }
+            trace.sample_types[topic] = type;
+        });
     }
     // Every row goes through the digest, in the canonical form TraceFile takes it over.
     Sha256 digest;
-    reader.rows("SELECT t_ns, round, topic, json, rowid FROM samples ORDER BY rowid", [&](sqlite3_stmt* row) {
-        TraceRow sample;
-        sample.t_ns = TraceReader::integer(row, 0);
-        sample.round = static_cast<int>(TraceReader::integer(row, 1));
-        const std::string topic = TraceReader::text(row, 2);
-        sample.json_text = TraceReader::text(row, 3);
-        sample.rowid = TraceReader::integer(row, 4);
-        digest.add(std::to_string(sample.t_ns) + " " + std::to_string(sample.round) + " " + topic + " " +
-                   sample.json_text + "\n");
-        trace.rows[topic].push_back(std::move(sample));
-    });
+    Sha256 cdr_digest;
+    reader.rows(with_bytes ? "SELECT t_ns, round, topic, json, rowid, cdr FROM samples ORDER BY rowid"
+                           : "SELECT t_ns, round, topic, json, rowid FROM samples ORDER BY rowid",
+                [&](sqlite3_stmt* row) {
+                    TraceRow sample;
+                    sample.t_ns = TraceReader::integer(row, 0);
+                    sample.round = static_cast<int>(TraceReader::integer(row, 1));
+                    const std::string topic = TraceReader::text(row, 2);
+                    sample.json_text = TraceReader::text(row, 3);
+                    sample.rowid = TraceReader::integer(row, 4);
+                    digest.add(sample_digest_line(sample.t_ns, sample.round, topic, sample.json_text));
+                    if (with_bytes) {
+                        sample.cdr = TraceReader::blob(row, 5);
+                        if (!sample.cdr.empty()) {
+                            add_cdr_digest(cdr_digest, sample.t_ns, sample.round, topic, sample.cdr.data(),
+                                           sample.cdr.size());
+                        }
+                    }
+                    trace.rows[topic].push_back(std::move(sample));
+                });
     reader.rows("SELECT pass, row, nozzle, dose_ul_cm2 FROM deposition ORDER BY rowid", [&](sqlite3_stmt* row) {
         RecordedDepositionCell cell;
         cell.pass = static_cast<int>(TraceReader::integer(row, 0));
@@ -129,6 +173,7 @@ RecordedTrace read_trace(const std::filesystem::path& file) {
         trace.landing_edges.push_back(edge);
     });
     trace.recomputed_sha256 = digest.hex();
+    trace.recomputed_cdr_sha256 = cdr_digest.hex();
     reader.rows("SELECT t_ns, participant, guid_prefix, endpoint, topic, event FROM discovery ORDER BY rowid",
                 [&](sqlite3_stmt* row) {
                     trace.discovery.push_back(RecordedDiscovery{

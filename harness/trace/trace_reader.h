@@ -2,9 +2,11 @@
 // Reading a trace file (docs/trace-format.md; harness/trace/trace_file.h
 // writes one). TraceReader is the one way the rig opens a trace: read_trace()
 // reads a whole one for the judge through it, and `rig mcap` streams its rows
-// through it. Nothing here knows a system: the samples stay JSON text until a
-// judge asks for a topic's, and the deposition and landing-edge rows are the
-// tables' own.
+// through it. Nothing here knows a system: the samples stay as stored until a
+// judge asks for a topic's, then become JSON values straight from their CDR
+// bytes (harness/trace/trace_cdr.h; text is parsed only for a row that has no
+// bytes: a format 2 trace, a hand-made one), and the deposition and
+// landing-edge rows are the tables' own.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -39,6 +41,7 @@ public:
     static std::string text(sqlite3_stmt* row, int column);
     static std::int64_t integer(sqlite3_stmt* row, int column);
     static double real(sqlite3_stmt* row, int column);
+    static std::vector<unsigned char> blob(sqlite3_stmt* row, int column);  // empty for NULL
 
 private:
     std::filesystem::path file_;
@@ -52,12 +55,14 @@ struct RecordedSample {
     nlohmann::json json;
 };
 
-// The same as stored: its JSON text and where it is (for errors).
+// The same as stored: its JSON text, its CDR bytes (none when stored as text
+// only) and where it is (for errors).
 struct TraceRow {
     TimeNs t_ns = 0;
     int round = 0;
     std::int64_t rowid = 0;
     std::string json_text;
+    std::vector<unsigned char> cdr;
 };
 
 struct RecordedDiscovery {
@@ -95,6 +100,7 @@ public:
     std::filesystem::path file;
     std::map<std::string, std::string> meta;
     std::map<std::string, std::vector<TraceRow>> rows;  // every topic's samples, in delivery order
+    std::map<std::string, std::string> sample_types;    // topic -> the IDL type of its rows' bytes
     std::vector<RecordedDepositionCell> deposition;    // in the order written
     std::vector<RecordedLandingEdge> landing_edges;
     std::vector<RecordedDiscovery> discovery;
@@ -102,10 +108,12 @@ public:
     // The digest recomputed from the tables (samples, deposition, landing edges),
     // to compare with meta's trace_sha256: a trace changed after its run differs.
     std::string recomputed_sha256;
+    // The same for the samples' bytes, to compare with meta's cdr_sha256 (format 3).
+    std::string recomputed_cdr_sha256;
 
     // The samples of `topic` parsed, in delivery order (none when it has none).
     // Parsed on first use and kept: a judge reads only the topics it judges.
-    // Throws std::runtime_error naming the file and the row of malformed JSON.
+    // Throws std::runtime_error naming the file and the row of malformed JSON or CDR.
     // Not for several threads at once.
     const std::vector<RecordedSample>& samples(const std::string& topic) const;
     // meta[key], or `fallback` when the trace has no such key.

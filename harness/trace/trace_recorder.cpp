@@ -4,18 +4,12 @@
 #include <map>
 #include <stdexcept>
 
-#include "harness/trace/topic_roles.h"
 #include "harness/trace/trace_json.h"
 #include "idl/topics.h"
 
 namespace rig::harness {
 
 TraceRecorder::TraceRecorder(DdsContext& dds, const std::filesystem::path& file) : dds_(dds), file_(file) {}
-
-void TraceRecorder::record_truth_at_controller_outputs(const char* topic, std::function<std::string(TimeNs)> json_at) {
-    truth_topic_ = topic;
-    truth_at_ = std::move(json_at);
-}
 
 bool TraceRecorder::records(const std::string& topic) const {
     return std::any_of(channels_.begin(), channels_.end(), [&](const Channel& channel) { return channel.topic == topic; });
@@ -50,36 +44,40 @@ void TraceRecorder::record_raw(const std::string& topic, const std::string& type
     }
     auto reader = std::make_shared<RawReader>(dds_, topic, type_name);
     readers_.push_back(reader);
-    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<std::string, std::string>>& out) {
-                                    for (auto& [sample, writer] : reader->take_all_with_writer()) {
-                                        out.emplace_back(cdr_hex_json_text(sample.bytes), std::move(writer));
-                                    }
-                                }});
+    // Bytes of a type the rig cannot decode: stored as JSON text only ({"cdr_hex": ...}).
+    Channel channel{topic, file_.topic_slot(topic), rig_only_topic(topic), controller_output_topic(topic), {}};
+    channel.drain = [this, reader, index = channels_.size()](TimeNs t, int round) {
+        const Channel& self = channels_[index];
+        std::size_t recorded = 0;
+        for (auto& [sample, writer] : reader->take_all_with_writer()) {
+            std::string text = cdr_hex_json_text(sample.bytes);
+            if (!admit(self, writer, t, round, [&text] { return text; })) continue;
+            file_.append_text(t, round, self.topic, std::move(text));
+            ++recorded;
+        }
+        return recorded;
+    };
+    channels_.push_back(std::move(channel));
+}
+
+void TraceRecorder::record_foreign(const Channel& channel, const std::string& writer, TimeNs t, int round,
+                                   const std::string& json_text) {
+    const std::string participant = dds_.participant_name(writer);
+    file_.append_foreign(t, round, channel.topic, participant, writer, json_text);
+    foreign_.push_back(ForeignSample{t, channel.topic, participant, writer});
 }
 
 void TraceRecorder::drain(TimeNs t, int round) {
     bool controller_output = false;
-    std::vector<std::pair<std::string, std::string>> taken;
     for (const Channel& channel : channels_) {
-        taken.clear();
-        channel.take(taken);
-        const bool rig_only = rig_only_topic(channel.topic);
-        for (auto& [text, writer] : taken) {
-            if (rig_only && !dds_.is_rig_participant(writer)) {
-                const std::string participant = dds_.participant_name(writer);
-                file_.append_foreign(t, round, channel.topic, participant, writer, text);
-                foreign_.push_back(ForeignSample{t, channel.topic, participant, writer});
-                continue;
-            }
-            file_.append_text(t, round, channel.topic, std::move(text));
-            if (channel.topic == truth_topic_) last_truth_ns_ = t;
-            controller_output |= controller_output_topic(channel.topic);
-        }
+        if (channel.drain(t, round) == 0) continue;
+        if (channel.topic == truth_topic_) last_truth_ns_ = t;
+        controller_output |= channel.controller_output;
     }
     // The plant at the instant the controller acted: the judge then needs no
     // interpolation (and no plant) to say where the sprayer was.
-    if (controller_output && truth_at_ && last_truth_ns_ != t) {
-        file_.append_text(t, round, truth_topic_, truth_at_(t));
+    if (controller_output && append_truth_at_ && last_truth_ns_ != t) {
+        append_truth_at_(t, round);
         last_truth_ns_ = t;
     }
 }

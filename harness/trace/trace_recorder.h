@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/trace/topic_roles.h"
 #include "harness/trace/trace_file.h"
 #include "harness/trace/trace_json.h"
 #include "rig/runtime/dds_context.h"
@@ -36,14 +37,16 @@ public:
     TraceRecorder& operator=(const TraceRecorder&) = delete;
 
     TraceFile& file() { return file_; }
-    // Records every sample of `topic`, as its type's JSON (harness/trace/trace_json.h).
+    // Records every sample of `topic`: its CDR bytes, and its type's JSON
+    // (harness/trace/trace_json.h) rendered from them off the loop (trace_file.h).
     template <class Msg>
     void record(const char* topic);
     // After a round in which the controller wrote (actuator/*, controller/*),
-    // `topic` also gets a sample of `json_at(t)` unless one arrived at that
+    // `topic` also gets the sample `truth_at(t)` unless one arrived at that
     // instant: the plant's state where the controller acted, so the judge
     // needs no plant and no interpolation there (seed 000's truth/vehicle).
-    void record_truth_at_controller_outputs(const char* topic, std::function<std::string(TimeNs)> json_at);
+    template <class Msg>
+    void record_truth_at_controller_outputs(const char* topic, std::function<Msg(TimeNs)> truth_at);
     // Takes every sample that arrived and records it at (t, round).
     void drain(TimeNs t, int round);
     // Samples other participants wrote on rig-only topics, so far.
@@ -59,29 +62,63 @@ public:
 private:
     struct Channel {
         std::string topic;
-        // Appends (JSON text, writer's GUID prefix) of every sample taken.
-        std::function<void(std::vector<std::pair<std::string, std::string>>&)> take;
+        std::uint32_t slot = 0;  // the topic's in the file
+        bool rig_only = false;   // truth/* or device/*: another participant's sample is forged
+        bool controller_output = false;  // actuator/*, controller/*
+        // Records every sample taken at (t, round); returns how many went into samples.
+        std::function<std::size_t(TimeNs t, int round)> drain;
     };
+    // Whether a sample `writer` wrote on the channel goes into samples; if not
+    // (forged), records it as foreign, `json_text()` its text.
+    template <class JsonText>
+    bool admit(const Channel& channel, const std::string& writer, TimeNs t, int round, const JsonText& json_text);
+    void record_foreign(const Channel& channel, const std::string& writer, TimeNs t, int round,
+                        const std::string& json_text);
 
     DdsContext& dds_;
     TraceFile file_;
     std::vector<Channel> channels_;  // drained in this fixed order
     std::vector<std::shared_ptr<void>> readers_;
     std::string truth_topic_;
-    std::function<std::string(TimeNs)> truth_at_;
+    std::function<void(TimeNs, int)> append_truth_at_;
     TimeNs last_truth_ns_ = -1;
     std::vector<ForeignSample> foreign_;
 };
+
+template <class JsonText>
+bool TraceRecorder::admit(const Channel& channel, const std::string& writer, TimeNs t, int round,
+                          const JsonText& json_text) {
+    if (!channel.rig_only || dds_.is_rig_participant(writer)) return true;
+    record_foreign(channel, writer, t, round, json_text());
+    return false;
+}
 
 template <class Msg>
 void TraceRecorder::record(const char* topic) {
     auto reader = std::make_shared<Reader<Msg>>(dds_, topic);
     readers_.push_back(reader);
-    channels_.push_back(Channel{topic, [reader](std::vector<std::pair<std::string, std::string>>& out) {
-                                    for (auto& [sample, writer] : reader->take_all_with_writer()) {
-                                        out.emplace_back(to_json_text(sample), std::move(writer));
-                                    }
-                                }});
+    Channel channel{topic, file_.topic_slot(topic, &sample_codec<Msg>()), rig_only_topic(topic),
+                    controller_output_topic(topic), {}};
+    channel.drain = [this, reader, index = channels_.size()](TimeNs t, int round) {
+        const Channel& self = channels_[index];
+        std::size_t recorded = 0;
+        for (auto& [sample, writer] : reader->take_all_with_writer()) {
+            if (!admit(self, writer, t, round, [&sample = sample] { return to_json_text(sample); })) continue;
+            file_.append_sample(t, round, self.slot, sample);
+            ++recorded;
+        }
+        return recorded;
+    };
+    channels_.push_back(std::move(channel));
+}
+
+template <class Msg>
+void TraceRecorder::record_truth_at_controller_outputs(const char* topic, std::function<Msg(TimeNs)> truth_at) {
+    truth_topic_ = topic;
+    const std::uint32_t slot = file_.topic_slot(topic, &sample_codec<Msg>());
+    append_truth_at_ = [this, slot, truth_at = std::move(truth_at)](TimeNs t, int round) {
+        file_.append_sample(t, round, slot, truth_at(t));
+    };
 }
 
 }  // namespace rig::harness

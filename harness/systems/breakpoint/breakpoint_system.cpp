@@ -185,8 +185,8 @@ public:
         // The plant at the instant the controller acted (a pure function of t):
         // the judge then needs no interpolation, and no plant, to say where the sprayer was.
         const emulators::Plant& plant = world_.plant;
-        trace.record_truth_at_controller_outputs(topics::kVehicleTruth,
-                                                 [&plant](TimeNs t) { return to_json_text(plant.truth_at(t)); });
+        trace.record_truth_at_controller_outputs<msg::VehicleTruth>(
+            topics::kVehicleTruth, [&plant](TimeNs t) { return plant.truth_at(t); });
     }
 
     void describe_attach(nlohmann::json& attach, std::uint32_t dds_domain) const override {
