@@ -466,8 +466,8 @@ std::optional<TimeNs> LockstepMaster::advance(TimeNs until_ns) {
         // remotes published is in the local readers now (wait_local_readers),
         // and a remote is ticked again at t only for what the local nodes
         // publish. A round for the remotes' samples alone stepped no node and
-        // recorded nothing (half the rounds of a case whose controller answers
-        // every tick), so it is not run.
+        // recorded nothing (the recorder drained them in this round), so it is
+        // not run: continuation-6kmh 7733 -> 7091 rounds, the same trace.
         bool pending = false;
         for (const Local& local : locals_) pending |= local.node->has_unread_input();
         if (!pending) break;
