@@ -60,10 +60,15 @@ TEST(SpeedBench, PrintsTheFloorAndBothModesAndWritesBenchJson) {
     EXPECT_GT(bench.at("process").at("allocations_per_round").get<double>(), 0.0);
     EXPECT_LT(bench.at("in_process").at("allocations_per_round").get<double>(),
               bench.at("process").at("allocations_per_round").get<double>());
-    // Every mode recorded the same samples: the same trace size.
-    EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"), bench.at("in_process").at("trace_bytes_per_sim_minute"));
-    EXPECT_EQ(bench.at("process").at("trace_bytes_per_sim_minute"),
-              bench.at("process_unpinned").at("trace_bytes_per_sim_minute"));
+    // Every mode recorded the same samples (their digests are the same, above):
+    // the same trace size, but for the pages of `meta`, whose text says the mode
+    // and the controller's command, so that in process mode it may take a page
+    // or two of 4 KiB more in a file of about 7 MB (0.5 % is 8 such pages).
+    const double process_bytes = bench.at("process").at("trace_bytes_per_sim_minute").get<double>();
+    for (const char* mode : {"in_process", "process_unpinned"}) {
+        SCOPED_TRACE(mode);
+        EXPECT_NEAR(bench.at(mode).at("trace_bytes_per_sim_minute").get<double>(), process_bytes, 0.005 * process_bytes);
+    }
 }
 
 TEST(SpeedBench, WithDdsSecurityAddsTheSecuredFloorAndProcessModeWithTheSameDigest) {

@@ -24,10 +24,11 @@
 // Samples are written off the lockstep round's critical path: append_sample()
 // queues the sample's CDR bytes (harness/trace/trace_cdr.h; no text on the
 // loop) and a writer thread of the file's own renders its JSON text from them,
-// digests it and inserts both, in the order queued (so the digest is the same). Every other call
-// first waits for the queue to drain, so the file is only ever touched by one
-// thread at a time; all calls come from the thread that runs the case. A write
-// that fails (a full disk) is reported by the next call, naming the file.
+// digests it and inserts both, in the order queued (so the digest is the
+// same). Every other call first waits for the queue to drain, so the file is
+// only ever touched by one thread at a time; all calls come from the thread
+// that runs the case. A write that fails (a full disk) is reported by the next
+// call, naming the file.
 #include <condition_variable>
 #include <cstdint>
 #include <filesystem>
