@@ -278,6 +278,14 @@ std::size_t choice_cells(const std::vector<VaryRange>& space) {
     return cells;
 }
 
+void check_choice_cells(const std::vector<VaryRange>& space, std::size_t budget) {
+    if (const std::size_t cells = choice_cells(space); cells > budget) {
+        throw std::invalid_argument("the choices give " + std::to_string(cells) + " combinations, each searched "
+                                    "on its own, more than the budget of " + std::to_string(budget) +
+                                    " points: raise --budget or list fewer choices");
+    }
+}
+
 namespace {
 
 // One cell's search over its free keys with the points the budget leaves it.
@@ -311,12 +319,8 @@ SearchOutcome falsify_search(const std::vector<VaryRange>& space, const SearchOp
     // what the budget leaves: a method that learns from margins would
     // otherwise settle on the choice its first good point had, however
     // badly another choice breaks (a choice has no slope to follow).
+    check_choice_cells(space, options.budget);
     const std::size_t cells = choice_cells(space);
-    if (cells > options.budget) {
-        throw std::invalid_argument("the choices give " + std::to_string(cells) +
-                                    " combinations, more than the budget of " + std::to_string(options.budget) +
-                                    " points: raise --budget or list fewer choices");
-    }
     for (std::size_t cell = 0; cell < cells && !state.finished(); ++cell) {
         std::vector<double> choices;
         std::size_t rest = cell;

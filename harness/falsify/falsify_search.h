@@ -80,6 +80,9 @@ struct SearchOutcome {
 // The number of combinations of the space's choice keys' choices (1 without
 // any): the search runs one cell per combination, each over the numeric keys.
 std::size_t choice_cells(const std::vector<VaryRange>& space);
+// Throws std::invalid_argument, saying what to do, when the choices give more
+// cells than the budget has points.
+void check_choice_cells(const std::vector<VaryRange>& space, std::size_t budget);
 
 // Throws std::invalid_argument when the choices give more cells than the budget.
 SearchOutcome falsify_search(const std::vector<VaryRange>& space, const SearchOptions& options,

@@ -184,11 +184,7 @@ PreparedSearch prepare_search(const FalsifyRequest& request, const RunOptions& o
         }
         check_range(search.ranges[index], request, prepared.base_text, options);
     }
-    if (const std::size_t cells = choice_cells(search.ranges); cells > request.options.budget) {
-        throw std::invalid_argument("the choices give " + std::to_string(cells) + " combinations, each searched "
-                                    "on its own, more than the budget of " + std::to_string(request.options.budget) +
-                                    " points: raise --budget or list fewer choices");
-    }
+    check_choice_cells(search.ranges, request.options.budget);
     const std::map<std::string, double> limits = effective_limits(prepared.base);
     const std::vector<std::string> limited = limited_metrics(limits);
     search.metrics = request.metrics.empty() ? limited : request.metrics;
