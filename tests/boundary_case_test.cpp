@@ -211,12 +211,21 @@ TEST(BoundaryCase, MistakesAreErrorsAtTheirKey) {
     EXPECT_NE(load_error(edited("system: boundary", "system: boundry")).find("did you mean 'boundary'"), std::string::npos);
 }
 
-// `guidance:` (docs/guidance.md): absent, the route is driven exactly; `{}`
-// takes every default; a value outside its bounds or an unknown key is an
-// error at the section, naming the key.
-TEST(BoundaryCase, GuidanceIsOptInAndItsValuesAreHeldToTheirBounds) {
+// `guidance:` (docs/guidance.md): absent or `{}`, every default (the sprayer
+// is autosteered); `off`, the route is driven exactly; any other word is an
+// error naming it; a value outside its bounds or an unknown key is an error at
+// the section, naming the key.
+TEST(BoundaryCase, GuidanceIsOnUnlessOffAndItsValuesAreHeldToTheirBounds) {
     const auto guidance_of = [](const std::string& text) { return boundary_sections(parse_case(text, "case.yaml")).guidance; };
-    EXPECT_FALSE(guidance_of(edited("judge:\n", "judge:\n")).has_value());
+    const auto without = guidance_of(edited("judge:\n", "judge:\n"));
+    ASSERT_TRUE(without.has_value());
+    EXPECT_EQ(without->yaw_disturbance_sd_deg_m, rig::emulators::guidance::GuidanceParams{}.yaw_disturbance_sd_deg_m);
+    EXPECT_FALSE(guidance_of(edited("judge:\n", "guidance: off\njudge:\n")).has_value());
+    const std::string word = load_error(edited("judge:\n", "guidance: on\njudge:\n"));
+    EXPECT_NE(word.find("guidance: expected off (the route driven exactly) or a mapping"), std::string::npos) << word;
+    EXPECT_NE(word.find("'on'"), std::string::npos) << word;
+    EXPECT_NE(load_error(edited("judge:\n", "guidance: [ 1 ]\njudge:\n")).find("guidance: expected off"),
+              std::string::npos);
     const auto defaults = guidance_of(edited("judge:\n", "guidance: {}\njudge:\n"));
     ASSERT_TRUE(defaults.has_value());
     EXPECT_EQ(defaults->wheelbase_m, rig::emulators::guidance::GuidanceParams{}.wheelbase_m);

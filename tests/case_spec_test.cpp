@@ -251,6 +251,12 @@ TEST(CaseSpec, DefaultsApplyToEverythingNotWritten) {
     // An identification case measures only the breakpoint error of the defaults.
     EXPECT_EQ(breakpoint_sections(spec).scenario_kind, Scenario::breakpoint_identification);
     EXPECT_EQ(effective_limits(spec), (std::map<std::string, double>{{"breakpoint_error_m", 0.20}}));
+    // The sprayer is on autosteer unless the case says `guidance: off` (docs/guidance.md).
+    ASSERT_TRUE(breakpoint_sections(spec).guidance.has_value());
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).guidance->roll_sd_deg, rig::emulators::guidance::GuidanceParams{}.roll_sd_deg);
+    EXPECT_DOUBLE_EQ(breakpoint_sections(spec).antenna.height_m, defaults.antenna.height_m);
+    const CaseSpec exact = load_case_file(dir.write("exact.yaml", std::string(kMinimalCase) + "guidance: off\n"));
+    EXPECT_FALSE(breakpoint_sections(exact).guidance.has_value());
 }
 
 TEST(CaseSpec, DefaultLimitsFollowWhatTheScenarioMeasures) {

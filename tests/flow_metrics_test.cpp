@@ -456,6 +456,34 @@ TEST(BreakpointMetrics, ADeclarationOutsideTheRecordedTruthIsNotMeasured) {
               "1.000 s to 2.000 s");
 }
 
+// The stored breakpoint is judged against where the vehicle stood when it
+// stored: on autosteer the antenna stops some cm off the A-B line, and a
+// controller storing that place is right (across the line); along it, the
+// breakpoint. On the exact route (antenna on the line) the same as before.
+// (0.2 mm: the event's point is read back at the ellipsoid, 50 m below the
+// field's origin, where the frame's metres are a little shorter.)
+TEST(BreakpointMetrics, TheStoredPositionIsJudgedAgainstWhereTheVehicleStood) {
+    const rig::emulators::FieldFrame field(40.18, 116.44, 50.0, 90.0);
+    const auto stored_at = [&](double along_m, double cross_m) {
+        const rig::emulators::GeoPoint point = field.to_geodetic(along_m, cross_m);
+        return rig::harness::BreakpointEventSample{1500 * kMs, "stored", point.lat_deg, point.lon_deg};
+    };
+    // Stopped 12 cm right of the line at the breakpoint (10 m), from 1 s to 2 s.
+    const rig::harness::VehicleTrack guided({{1 * kS, 10.0, 0, 0.12}, {2 * kS, 10.0, 0, 0.12}});
+    EXPECT_NEAR(at(rig::harness::breakpoint_metrics({stored_at(10.03, 0.12)}, guided, field, 10.0),
+                   "breakpoint_store_error_m"),
+                0.03, 2e-4);
+    // Storing the line's point instead of where it stood is 12 cm off.
+    EXPECT_NEAR(at(rig::harness::breakpoint_metrics({stored_at(10.0, 0.0)}, guided, field, 10.0),
+                   "breakpoint_store_error_m"),
+                0.12, 2e-4);
+    // The exact route: the antenna on the line, the distance from the breakpoint.
+    const rig::harness::VehicleTrack exact({{1 * kS, 10.0, 0}, {2 * kS, 10.0, 0}});
+    EXPECT_NEAR(at(rig::harness::breakpoint_metrics({stored_at(10.03, 0.04)}, exact, field, 10.0),
+                   "breakpoint_store_error_m"),
+                0.05, 2e-4);
+}
+
 TEST(DepositionMetrics, RowBelowHalfTheNominalDoseCountsAsUnsprayed) {
     // One thin row (0.4 x nominal) in the first pass at -2 m, one at exactly half (sprayed).
     const auto p = profile(

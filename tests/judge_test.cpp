@@ -94,7 +94,7 @@ public:
             const bool second = t >= 30 * kS;
             const double along_m = second ? -8.0 + (t_s - 30.0) * 6.0 / 3.6 : std::min(0.0, -25.0 + t_s * 6.0 / 3.6);
             trace_.append(t, 0, rig::topics::kVehicleTruth,
-                          {{"nozzle_line_along_m", along_m}, {"pass_index", second ? 1 : 0}});
+                          {{"nozzle_line_along_m", along_m}, {"pass_index", second ? 1 : 0}, {"cross_m", 0.0}});
         }
     }
     // Section commands, and the hydraulics truth every 10 ms from 25 s to 60 s.

@@ -6,7 +6,14 @@
 namespace rig::harness {
 
 std::optional<emulators::guidance::GuidanceParams> read_guidance_section(const YamlSection& root) {
-    if (!root.has("guidance")) return std::nullopt;
+    if (root.has("guidance")) {
+        const RawYaml written = root.raw("guidance");
+        if (written.node.IsScalar() && written.node.Scalar() == "off") return std::nullopt;
+        if (!written.node.IsMap() && !written.node.IsNull()) {
+            root.fail("guidance", "expected off (the route driven exactly) or a mapping of the guidance's keys "
+                                  "(no section: every default); got " + describe_node(written.node));
+        }
+    }
     using Params = emulators::guidance::GuidanceParams;
     static constexpr std::pair<const char*, double Params::*> kFields[] = {
         {"wheelbase_m", &Params::wheelbase_m},

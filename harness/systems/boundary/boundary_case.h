@@ -17,7 +17,7 @@
 //             cameras: {CameraEmulatorParams fields for both}, left: / right:
 //             { faults: { pitch_offset_deg, blur_radius_px, colour_cast, dead } }
 //   guidance: autosteer over a rough ground instead of the exact route
-//             (harness/spec/guidance_section.h, docs/guidance.md); absent: exact
+//             (harness/spec/guidance_section.h, docs/guidance.md); `off`: exact
 //   judge:    ground grid, wet threshold, the edges to measure and the metric
 //             each gives, flow per duty (Table 3), centre_rule (Sec. 4.2's
 //             boom-centre rule, Table 8 "along, boom centre outside"), vision
@@ -98,7 +98,7 @@ public:
     field2d::RouteStart route_start;
     std::vector<field2d::RouteSegment> route_segments;
     field2d::SprayerMounting mounting;
-    std::optional<emulators::guidance::GuidanceParams> guidance;  // absent: the route driven exactly
+    std::optional<emulators::guidance::GuidanceParams> guidance;  // nullopt (`guidance: off`): the route driven exactly
     std::vector<field2d::HeightKnot> boom_height{field2d::HeightKnot{0.0, 0.5}};
     emulators::SprayDepositionParams spray;
     std::vector<std::vector<field2d::FlowPoint>> flow_table;  // empty: Table 3 as printed

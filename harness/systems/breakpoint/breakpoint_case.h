@@ -292,8 +292,8 @@ public:
     DepositionSpec deposition;
     StaticFlowSpec static_flow;
     // `guidance:` (harness/spec/guidance_section.h, docs/guidance.md): autosteer
-    // along the A-B line over a rough ground; absent, the line is driven
-    // exactly. Its antenna_forward_of_axle_m and antenna_height_m place the
+    // along the A-B line over a rough ground, unless the case says
+    // `guidance: off` (nullopt: the line driven exactly). Its antenna_forward_of_axle_m and antenna_height_m place the
     // antenna on the body (emulators/guidance/guidance_params.h's AntennaMount).
     std::optional<emulators::guidance::GuidanceParams> guidance;
     emulators::guidance::AntennaMount antenna;

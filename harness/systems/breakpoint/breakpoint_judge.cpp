@@ -117,7 +117,7 @@ std::vector<VehicleSample> vehicle_samples(const RecordedTrace& trace) {
     std::vector<VehicleSample> samples;
     for (const RecordedSample& sample : trace.samples(topics::kVehicleTruth)) {
         samples.push_back(VehicleSample{sample.t_ns, sample.json.at("nozzle_line_along_m").get<double>(),
-                                        sample.json.at("pass_index").get<int>()});
+                                        sample.json.at("pass_index").get<int>(), sample.json.at("cross_m").get<double>()});
     }
     return samples;
 }

@@ -24,11 +24,15 @@ VehicleTrack::VehicleTrack(std::vector<VehicleSample> samples) : samples_(std::m
                      [](const VehicleSample& a, const VehicleSample& b) { return a.t_ns < b.t_ns; });
 }
 
-std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const {
+std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const { return at(t, &VehicleSample::nozzle_line_along_m); }
+
+std::optional<double> VehicleTrack::antenna_cross_m(TimeNs t) const { return at(t, &VehicleSample::antenna_cross_m); }
+
+std::optional<double> VehicleTrack::at(TimeNs t, double VehicleSample::*field) const {
     if (samples_.empty()) return std::nullopt;
     const auto after = std::lower_bound(samples_.begin(), samples_.end(), t,
                                         [](const VehicleSample& sample, TimeNs at) { return sample.t_ns < at; });
-    if (after != samples_.end() && after->t_ns == t) return after->nozzle_line_along_m;
+    if (after != samples_.end() && after->t_ns == t) return (*after).*field;
     // Before the first sample or after the last, truth does not say where the
     // nozzle line was: no position, never the nearest one held.
     if (after == samples_.begin() || after == samples_.end()) return std::nullopt;
@@ -36,10 +40,10 @@ std::optional<double> VehicleTrack::nozzle_line_along_m(TimeNs t) const {
     // Across a headland turn the two neighbours are on different passes: the
     // vehicle was on `before`'s pass until the reposition, which the truth
     // stream dates to its first sample of the new pass at the latest.
-    if (before.pass_index != after->pass_index) return before.nozzle_line_along_m;
+    if (before.pass_index != after->pass_index) return before.*field;
     const double fraction =
         static_cast<double>(t - before.t_ns) / static_cast<double>(after->t_ns - before.t_ns);
-    return before.nozzle_line_along_m + fraction * (after->nozzle_line_along_m - before.nozzle_line_along_m);
+    return before.*field + fraction * ((*after).*field - before.*field);
 }
 
 std::string VehicleTrack::describe_span() const {
@@ -66,7 +70,12 @@ MetricSet breakpoint_metrics(const std::vector<BreakpointEventSample>& events, c
         if (event.kind == "stored" && !metrics.values.count("breakpoint_store_error_m") && event.lat_deg &&
             event.lon_deg && std::isfinite(*event.lat_deg) && std::isfinite(*event.lon_deg)) {
             const auto [along_m, cross_m] = field.to_line(emulators::GeoPoint{*event.lat_deg, *event.lon_deg, 0.0});
-            metrics.values["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m);
+            // Across the line, the true place is where the vehicle stood when it
+            // stored (its antenna's offset: 0 on the exact route). On autosteer the
+            // body stops some cm off the line; the controller storing where it
+            // really was is right, and that offset is the autosteer's, not its error.
+            const double true_cross_m = track.antenna_cross_m(event.t_ns).value_or(0.0);
+            metrics.values["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m - true_cross_m);
         }
         if (event.kind == "reached" && ++reached == 1) {
             // Truth at the instant the controller decided (the trace holds the plant's state then).

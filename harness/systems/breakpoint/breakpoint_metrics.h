@@ -28,6 +28,9 @@ struct VehicleSample {
     TimeNs t_ns = 0;
     double nozzle_line_along_m = 0.0;
     int pass_index = 0;
+    // The antenna's offset right of the A-B line (truth/vehicle `cross_m`): 0 on
+    // the exact route; on autosteer the body's cross-track and its tilt's shift.
+    double antenna_cross_m = 0.0;
 };
 
 // The recorded truth/vehicle samples (20 Hz, plus one at every instant the
@@ -41,12 +44,15 @@ public:
     explicit VehicleTrack(std::vector<VehicleSample> samples);  // any order; sorted here
     bool empty() const { return samples_.empty(); }
     std::optional<double> nozzle_line_along_m(TimeNs t) const;
+    // Where the antenna was across the line at t, by the same rule.
+    std::optional<double> antenna_cross_m(TimeNs t) const;
     // "the vehicle truth recorded spans 0.000 s to 41.250 s": why a time outside it has no position.
     std::string describe_span() const;
     // The first pass_index's first sample time (e.g. when pass 1 began); nullopt if never.
     std::optional<TimeNs> pass_start_ns(int pass_index) const;
 
 private:
+    std::optional<double> at(TimeNs t, double VehicleSample::*field) const;
     std::vector<VehicleSample> samples_;
 };
 
