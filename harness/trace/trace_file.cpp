@@ -2,6 +2,9 @@
 
 #include <sqlite3.h>
 
+#include <array>
+#include <charconv>
+#include <cmath>
 #include <iostream>
 #include <stdexcept>
 
@@ -80,31 +83,73 @@ constexpr std::size_t kMaxQueuedRows = 16384;
 // process took 12.4 s of CPU instead of 14.8 s (docs/speed.md).
 constexpr std::size_t kRowsPerWake = 1024;
 
+// A whole number as std::to_string writes it.
+template <class Integer>
+void add_integer(Sha256& digest, Integer value) {
+    std::array<char, 24> text{};
+    const char* end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
+    digest.add(text.data(), static_cast<std::size_t>(end - text.data()));
+}
+
+// "t_ns round topic ", how both digests' sample lines begin.
+void add_row_head(Sha256& digest, TimeNs t, int round, std::string_view topic) {
+    add_integer(digest, t);
+    digest.add(' ');
+    add_integer(digest, round);
+    digest.add(' ');
+    digest.add(topic);
+    digest.add(' ');
+}
+
 }  // namespace
 
-std::string sample_digest_line(TimeNs t, int round, const std::string& topic, const std::string& json_text) {
-    return std::to_string(t) + " " + std::to_string(round) + " " + topic + " " + json_text + "\n";
+void add_sample_digest(Sha256& digest, TimeNs t, int round, std::string_view topic, std::string_view json_text) {
+    add_row_head(digest, t, round, topic);
+    digest.add(json_text);
+    digest.add('\n');
 }
 
-std::string deposition_digest_line(int pass, std::size_t row, int nozzle, double dose_ul_cm2) {
-    return "deposition " + std::to_string(pass) + " " + std::to_string(row) + " " + std::to_string(nozzle) + " " +
-           nlohmann::json(dose_ul_cm2).dump() + "\n";
+void add_deposition_digest(Sha256& digest, int pass, std::size_t row, int nozzle, double dose_ul_cm2) {
+    digest.add(std::string_view("deposition "));
+    add_integer(digest, pass);
+    digest.add(' ');
+    add_integer(digest, row);
+    digest.add(' ');
+    add_integer(digest, nozzle);
+    digest.add(' ');
+    // As nlohmann::json(dose).dump(): null when not finite, else its shortest round-trip digits.
+    if (!std::isfinite(dose_ul_cm2)) {
+        digest.add(std::string_view("null"));
+    } else {
+        std::array<char, 64> text{};
+        const char* end = nlohmann::detail::to_chars(text.data(), text.data() + text.size(), dose_ul_cm2);
+        digest.add(text.data(), static_cast<std::size_t>(end - text.data()));
+    }
+    digest.add('\n');
 }
 
-std::string landing_digest_line(TimeNs t, bool landing) {
-    return "landing " + std::to_string(t) + " " + (landing ? "1" : "0") + "\n";
+void add_landing_digest(Sha256& digest, TimeNs t, bool landing) {
+    digest.add(std::string_view("landing "));
+    add_integer(digest, t);
+    digest.add(std::string_view(landing ? " 1\n" : " 0\n"));
 }
 
-void add_cdr_digest(Sha256& digest, TimeNs t, int round, const std::string& topic, const unsigned char* cdr,
+void add_cdr_digest(Sha256& digest, TimeNs t, int round, std::string_view topic, const unsigned char* cdr,
                     std::size_t size) {
-    digest.add(std::to_string(t) + " " + std::to_string(round) + " " + topic + " " + std::to_string(size) + "\n");
+    add_row_head(digest, t, round, topic);
+    add_integer(digest, size);
+    digest.add('\n');
     digest.add(cdr, size);
 }
 
 TraceFile::TraceFile(const std::filesystem::path& file) : file_(file) {
     std::filesystem::remove(file);
     for (const char* suffix : {"-wal", "-shm"}) std::filesystem::remove(file.string() + suffix);
-    if (sqlite3_open(file.c_str(), &db_) != SQLITE_OK) {
+    // Without SQLite's own lock on the connection, taken and released in every
+    // call for nothing: two threads use it, never at once (every call but an
+    // append waits for the writer thread to be idle, sync()).
+    if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, nullptr) !=
+        SQLITE_OK) {
         const std::string reason = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
         sqlite3_close(db_);
         db_ = nullptr;
@@ -155,8 +200,6 @@ void TraceFile::fail(const std::string& sqlite_error) {
     }
     throw std::runtime_error("trace " + file_.string() + ": " + sqlite_error);
 }
-
-void TraceFile::digest(const std::string& canonical) { digest_.add(canonical); }
 
 void TraceFile::writer_loop() {
     // Started by a lockstep case's thread on its leased CPU (rig/host/cpu_lease.h):
@@ -307,7 +350,7 @@ void TraceFile::write_row(const PendingRow& row, const std::vector<unsigned char
         }
     }
     const std::string& text = row.binary ? rendered : row.json_text;
-    digest(sample_digest_line(row.t, row.round, topic.name, text));
+    add_sample_digest(digest_, row.t, row.round, topic.name, text);
     sqlite3_bind_int64(insert_, 1, row.t);
     sqlite3_bind_int(insert_, 2, row.round);
     sqlite3_bind_text(insert_, 3, topic.name.c_str(), static_cast<int>(topic.name.size()), SQLITE_STATIC);
@@ -393,7 +436,7 @@ void TraceFile::record_deposition(const DepositionLayout& layout, const std::vec
     // Each cell also goes into the digest, so a changed deposition changes
     // trace_sha256 like a changed sample does.
     for (const DepositionCell& cell : cells) {
-        digest(deposition_digest_line(cell.pass, cell.row, cell.nozzle, cell.dose_ul_cm2));
+        add_deposition_digest(digest_, cell.pass, cell.row, cell.nozzle, cell.dose_ul_cm2);
         sqlite3_bind_int(statement, 1, cell.pass);
         sqlite3_bind_int64(statement, 2, static_cast<sqlite3_int64>(cell.row));
         sqlite3_bind_double(statement, 3, cell.along_m);
@@ -416,7 +459,7 @@ void TraceFile::record_landing_edges(const std::vector<LandingEdgeRow>& edges) {
         fail(sqlite3_errmsg(db_));
     }
     for (const LandingEdgeRow& edge : edges) {
-        digest(landing_digest_line(edge.t_ns, edge.landing));
+        add_landing_digest(digest_, edge.t_ns, edge.landing);
         sqlite3_bind_int64(statement, 1, edge.t_ns);
         sqlite3_bind_int(statement, 2, edge.landing ? 1 : 0);
         if (sqlite3_step(statement) != SQLITE_DONE) {

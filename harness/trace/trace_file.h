@@ -34,6 +34,7 @@
 #include <filesystem>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -64,15 +65,19 @@ struct TraceOutcome {
     TimeNs end_ns = 0;                 // the last simulated instant the run reached
 };
 
-// The canonical lines the digest is taken over (TraceFile writes them, the
-// reader recomputes them: harness/trace/trace_reader.h), one per row.
-std::string sample_digest_line(TimeNs t, int round, const std::string& topic, const std::string& json_text);
-std::string deposition_digest_line(int pass, std::size_t row, int nozzle, double dose_ul_cm2);
-std::string landing_digest_line(TimeNs t, bool landing);
+// The canonical lines the digest is taken over (TraceFile adds them, the
+// reader recomputes them: harness/trace/trace_reader.h), one per row:
+// "t_ns round topic json\n", "deposition pass row nozzle dose\n" (the dose
+// as nlohmann::json::dump() writes a double), "landing t_ns 0|1\n". Added
+// piece by piece, with no line built in between (the writer thread adds one
+// per sample).
+void add_sample_digest(Sha256& digest, TimeNs t, int round, std::string_view topic, std::string_view json_text);
+void add_deposition_digest(Sha256& digest, int pass, std::size_t row, int nozzle, double dose_ul_cm2);
+void add_landing_digest(Sha256& digest, TimeNs t, bool landing);
 // What meta `cdr_sha256` is taken over for one sample stored as bytes: the line
 // "t_ns round topic size\n", then the bytes. It shows a changed `cdr` column as
 // trace_sha256 shows a changed `json` one (the judge reads the bytes).
-void add_cdr_digest(Sha256& digest, TimeNs t, int round, const std::string& topic, const unsigned char* cdr,
+void add_cdr_digest(Sha256& digest, TimeNs t, int round, std::string_view topic, const unsigned char* cdr,
                     std::size_t size);
 
 // Spray on the ground for the `deposition` table (seed 000's grid along the
@@ -162,7 +167,6 @@ private:
     // Records the first SQLite error (see first_error_), then throws it naming the file.
     [[noreturn]] void fail(const std::string& sqlite_error);
     void exec(const char* sql);
-    void digest(const std::string& canonical);
     // On the writer thread; `bytes` holds binary rows' CDR.
     void write_row(const PendingRow& row, const std::vector<unsigned char>& bytes);
     void writer_loop();

@@ -148,7 +148,7 @@ RecordedTrace read_trace(const std::filesystem::path& file) {
                     const std::string topic = TraceReader::text(row, 2);
                     sample.json_text = TraceReader::text(row, 3);
                     sample.rowid = TraceReader::integer(row, 4);
-                    digest.add(sample_digest_line(sample.t_ns, sample.round, topic, sample.json_text));
+                    add_sample_digest(digest, sample.t_ns, sample.round, topic, sample.json_text);
                     if (with_bytes) {
                         sample.cdr = TraceReader::blob(row, 5);
                         if (!sample.cdr.empty()) {
@@ -164,12 +164,12 @@ RecordedTrace read_trace(const std::filesystem::path& file) {
         cell.row = static_cast<std::size_t>(TraceReader::integer(row, 1));
         cell.nozzle = static_cast<int>(TraceReader::integer(row, 2));
         cell.dose_ul_cm2 = TraceReader::real(row, 3);
-        digest.add(deposition_digest_line(cell.pass, cell.row, cell.nozzle, cell.dose_ul_cm2));
+        add_deposition_digest(digest, cell.pass, cell.row, cell.nozzle, cell.dose_ul_cm2);
         trace.deposition.push_back(cell);
     });
     reader.rows("SELECT t_ns, landing FROM landing_edges ORDER BY rowid", [&](sqlite3_stmt* row) {
         const RecordedLandingEdge edge{TraceReader::integer(row, 0), TraceReader::integer(row, 1) != 0};
-        digest.add(landing_digest_line(edge.t_ns, edge.landing));
+        add_landing_digest(digest, edge.t_ns, edge.landing);
         trace.landing_edges.push_back(edge);
     });
     trace.recomputed_sha256 = digest.hex();
