@@ -37,6 +37,7 @@ constexpr std::int64_t kWindowMarginCells = 500;
 // A map coordinate that sees no ground is clamped here (relative to the boom
 // centre's cell), so it stays a finite 16-bit number after the window's offset.
 constexpr float kFarCells = 16'000.0F;
+static_assert(kFarCells < 32'768.0F && kMaxWindowSide + 2 * 64 < 32'768, "rows and the bits' row length fit 16 bits (sample_row_nearest)");
 // Rows of samples render() works through at a time: 2^16 samples, a band that
 // stays in cache and that OpenCV does on the calling thread (it splits a call
 // into stripes of 2^16 pixels; one stripe runs where it was called).
@@ -156,7 +157,10 @@ void sample_row_nearest(const float* xs, const float* ys, int width, const float
     const cv::v_float32x4 far_low = cv::v_setall_f32(-kFarCells), far_high = cv::v_setall_f32(kFarCells);
     const cv::v_int32x4 zero = cv::v_setzero_s32();
     const cv::v_int32x4 cols_held = cv::v_setall_s32(view.cols), rows_held = cv::v_setall_s32(view.rows_held);
-    const cv::v_int32x4 bits_per_row = cv::v_setall_s32(view.bits_per_row), first_col = cv::v_setall_s32(view.first_col);
+    // Each 32-bit lane (bits_per_row, 0) as 16-bit halves: a row (clamped to
+    // +-kFarCells, so it fits 16 bits) times it is one multiply-add of halves.
+    const cv::v_int16x8 bits_per_row = cv::v_reinterpret_as_s16(cv::v_setall_s32(view.bits_per_row));
+    const cv::v_int32x4 first_col = cv::v_setall_s32(view.first_col);
     const cv::v_int32x4 soil_bit = cv::v_setall_s32(view.zero_bit);
     int u = 0;
     for (; u + 4 <= width; u += 4) {
@@ -166,7 +170,8 @@ void sample_row_nearest(const float* xs, const float* ys, int width, const float
         const cv::v_int32x4 col = cv::v_round(cv::v_min(cv::v_max((h00 * x + h01 * y + h02) / depth, far_low), far_high));
         const cv::v_int32x4 row = cv::v_round(cv::v_min(cv::v_max((h10 * x + h11 * y + h12) / depth, far_low), far_high));
         const cv::v_int32x4 inside = (col >= zero) & (col < cols_held) & (row >= zero) & (row < rows_held);
-        cv::v_store(bits + u, cv::v_select(inside, row * bits_per_row + first_col + col, soil_bit));
+        const cv::v_int32x4 row_start = cv::v_dotprod(cv::v_reinterpret_as_s16(row), bits_per_row);
+        cv::v_store(bits + u, cv::v_select(inside, row_start + first_col + col, soil_bit));
     }
     for (; u < width; ++u) {
         const float depth = std::min(h[6] * xs[u] + h[7] * ys[u] + h[8], -1e-6F);
