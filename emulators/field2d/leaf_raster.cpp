@@ -20,9 +20,9 @@ constexpr double kFlat = 1e-12;
 constexpr double kCellsPerM = 1000.0;
 constexpr std::uint8_t kPlantCell = 255;
 
-// floor() of a value held within [low, high] first (ints all, so the
-// truncation is exact and needs no libm call on the baseline x86-64 target);
-// the same number as static_cast<int>(std::floor(value)) clamped to the range.
+// floor() of a value held within [low, high] first (so it fits an int, and
+// truncation and a correction give the floor without a libm call on the
+// baseline x86-64 target): std::floor(value) clamped to the range.
 int floor_within(double value, int low, int high) {
     const double held = std::clamp(value, static_cast<double>(low), static_cast<double>(high));
     const int truncated = static_cast<int>(held);
