@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "emulators/field2d/crop_cover_map.h"
 #include "emulators/vision/camera_emulator.h"
@@ -229,6 +231,42 @@ TEST(CropCoverCells, CopyAgreesWithIsPlant) {
     EXPECT_GT(plant, 1000);
     EXPECT_THROW(crop.copy_cells(0, 0, 0, 5, cells.data(), 1), std::invalid_argument);
     EXPECT_THROW(crop.copy_cells(999'999'999, 0, 5, 5, cells.data(), 5), std::invalid_argument);
+}
+
+TEST(CropCoverCells, BitsAreTheBytesOneBitACell) {
+    // A block across tile edges on both sides of the origin (tiles are 256
+    // cells), read both ways: bit k of word w is the byte of cell 64 w + k.
+    const CropCoverMap crop(CropCoverParams{}, 12);
+    const std::int64_t east = -640;
+    const std::int64_t north = -300;
+    const int words = 14;  // 896 cells
+    const int cols = words * CropCoverMap::kCellsPerWord;
+    const int rows = 610;
+    std::vector<std::uint8_t> cells(static_cast<std::size_t>(cols) * rows);
+    crop.copy_cells(east, north, cols, rows, cells.data(), cols);
+    const std::size_t stride = words + 3;  // rows further apart than they are long
+    std::vector<std::uint64_t> bits(stride * rows, 0x5a5a5a5a5a5a5a5aULL);
+    crop.copy_cell_bits(east, north, words, rows, bits.data(), stride);
+    int plant = 0;
+    for (int j = 0; j < rows; ++j) {
+        for (int i = 0; i < cols; ++i) {
+            const bool bit = ((bits[static_cast<std::size_t>(j) * stride + static_cast<std::size_t>(i / 64)] >> (i % 64)) & 1U) != 0;
+            ASSERT_EQ(bit, cells[static_cast<std::size_t>(j) * cols + i] == CropCoverMap::kPlantCell) << i << ", " << j;
+            plant += bit ? 1 : 0;
+        }
+        for (std::size_t w = words; w < stride; ++w) ASSERT_EQ(bits[static_cast<std::size_t>(j) * stride + w], 0x5a5a5a5a5a5a5a5aULL);
+    }
+    EXPECT_GT(plant, 50000);
+    EXPECT_LT(plant, cols * rows - 50000);
+    try {
+        crop.copy_cell_bits(-630, 0, 1, 1, bits.data(), 1);
+        FAIL() << "a block off the words' grid was copied";
+    } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find("crop copy_cell_bits"), std::string::npos) << error.what();
+        EXPECT_NE(std::string(error.what()).find("(-630, 0)"), std::string::npos) << error.what();
+    }
+    EXPECT_THROW(crop.copy_cell_bits(0, 0, 0, 5, bits.data(), 1), std::invalid_argument);
+    EXPECT_THROW(crop.copy_cell_bits(999'999'936, 0, 2, 5, bits.data(), 2), std::invalid_argument);
 }
 
 }  // namespace

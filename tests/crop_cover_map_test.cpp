@@ -9,6 +9,7 @@
 #include <vector>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "emulators/field2d/counter_hash.h"
 #include "emulators/field2d/crop_cover_map.h"
@@ -42,6 +43,62 @@ TEST(CropCoverMap, SameSeedSameFieldWhateverTheOrderOfLooking) {
     }
     EXPECT_GT(differ_from_other, 400);  // another seed is another field
     EXPECT_DOUBLE_EQ(a.cover_fraction(rectangle(1.0, 2.0, 0.6, 0.4)), b.cover_fraction(rectangle(1.0, 2.0, 0.6, 0.4)));
+}
+
+TEST(CropCoverMap, DroppingOldTilesChangesNoCell) {
+    // Past 1024 cached tiles the map drops its older half; a block looked at
+    // before, then after some 1100 other tiles, reads the same cells, as it
+    // does on a map that never looked elsewhere.
+    const CropCoverMap map(of_class(CoverClass::sparse), 13);
+    const CropCoverMap fresh(of_class(CoverClass::sparse), 13);
+    const int cols = 600;
+    const int rows = 400;
+    std::vector<std::uint8_t> before(static_cast<std::size_t>(cols) * rows);
+    map.copy_cells(-300, -200, cols, rows, before.data(), cols);
+    std::size_t most_cached = 0;
+    for (int i = 0; i < 40; ++i) {
+        for (int j = 0; j < 28; ++j) {
+            (void)map.is_plant(Vec2{20.0 + 0.256 * i, 20.0 + 0.256 * j});  // one tile each
+            most_cached = std::max(most_cached, map.cached_tile_count());
+        }
+    }
+    EXPECT_LE(most_cached, 1024U);
+    EXPECT_LT(map.cached_tile_count(), 1000U);  // it did drop some
+    std::vector<std::uint8_t> after(before.size());
+    map.copy_cells(-300, -200, cols, rows, after.data(), cols);
+    std::vector<std::uint8_t> untouched(before.size());
+    fresh.copy_cells(-300, -200, cols, rows, untouched.data(), cols);
+    EXPECT_EQ(after, before);
+    EXPECT_EQ(after, untouched);
+    EXPECT_GT(std::count(after.begin(), after.end(), CropCoverMap::kPlantCell), 10000);
+}
+
+TEST(CropCoverMap, MapsSharingTilesReadTheSameFieldFromTwoThreads) {
+    // Two cameras' maps share the tiles they build; each on its own thread
+    // reads an overlapping block (tiles built by one, the other or both at
+    // once), and both read what a map of its own reads.
+    const CropCoverMap original(CropCoverParams{}, 14);
+    CropCoverMap left = original.sharing_tiles();
+    CropCoverMap right = original.sharing_tiles();
+    EXPECT_NE(left.identity(), right.identity());
+    EXPECT_NE(left.identity(), original.identity());
+    const int cols = 1800;
+    const int rows = 900;
+    std::vector<std::uint8_t> left_cells(static_cast<std::size_t>(cols) * rows);
+    std::vector<std::uint8_t> right_cells(left_cells.size());
+    std::thread left_thread([&] { left.copy_cells(-1500, -300, cols, rows, left_cells.data(), cols); });
+    std::thread right_thread([&] { right.copy_cells(-300, -300, cols, rows, right_cells.data(), cols); });
+    left_thread.join();
+    right_thread.join();
+    const CropCoverMap own(CropCoverParams{}, 14);
+    std::vector<std::uint8_t> expected(left_cells.size());
+    own.copy_cells(-1500, -300, cols, rows, expected.data(), cols);
+    EXPECT_EQ(left_cells, expected);
+    own.copy_cells(-300, -300, cols, rows, expected.data(), cols);
+    EXPECT_EQ(right_cells, expected);
+    EXPECT_GT(std::count(expected.begin(), expected.end(), CropCoverMap::kPlantCell), 100000);
+    EXPECT_EQ(original.cached_tile_count(), 0U);  // built for the others, held by them
+    EXPECT_DOUBLE_EQ(original.cover_fraction(rectangle(-0.2, 0.1, 0.6, 0.4)), own.cover_fraction(rectangle(-0.2, 0.1, 0.6, 0.4)));
 }
 
 TEST(CropCoverMap, ClassesGiveTheirCoverAroundSec52sSplit) {
@@ -223,6 +280,39 @@ TEST(LeafRaster, DrawLeafMarksExactlyTheCellsWhoseCentresLieOnTheLeaf) {
         }
     }
     EXPECT_GT(leaf_cells, 50000);  // the leaves do cover cells
+}
+
+TEST(LeafRaster, LeavesWhoseEdgesMeetCellCentresAreDrawnExactly) {
+    // The runs' ends are settled by comparisons with the narrowed and the
+    // widened slice; leaves here put their edges and ends on cell centres
+    // (bases and tips on the centre grid or half a cell off it, widths whole
+    // and half cells), the crop's sizes on a tile-sized block, every cell
+    // checked against the exact test.
+    constexpr int kSide = 256;
+    HashStream random(hash_key(8, 9, 10));
+    auto on_grid = [&random](double span_m) { return (std::floor(random.uniform01() * span_m * 2000.0) * 0.5 + 0.5) * 0.001; };
+    std::vector<std::uint8_t> cells(kSide * kSide);
+    int leaf_cells = 0;
+    for (int k = 0; k < 300; ++k) {
+        const double bx = on_grid(0.256);
+        const double by = on_grid(0.256);
+        const int turn = static_cast<int>(random.uniform01() * 16.0);  // multiples of 22.5 deg, axes and diagonals among them
+        const double length = std::floor(random.uniform01() * 240.0) * 0.0005;
+        const double half_width = std::floor(1.0 + random.uniform01() * 12.0) * 0.0005;
+        const double azimuth = turn * 0.39269908169872414;
+        const LeafStrip leaf{bx, by, bx + length * std::cos(azimuth), by + length * std::sin(azimuth), half_width};
+        std::fill(cells.begin(), cells.end(), std::uint8_t{0});
+        draw_leaf(cells.data(), kSide, leaf);
+        for (int j = 0; j < kSide; ++j) {
+            for (int i = 0; i < kSide; ++i) {
+                const bool on = cell_on_leaf(leaf, i, j);
+                ASSERT_EQ(cells[static_cast<std::size_t>(j * kSide + i)] != 0, on)
+                    << "leaf " << k << " cell (" << i << ", " << j << ")";
+                leaf_cells += on ? 1 : 0;
+            }
+        }
+    }
+    EXPECT_GT(leaf_cells, 50000);
 }
 
 TEST(LeafRaster, FirstCentrePastSplitsARowAsCellByCellComparison) {

@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
+#include <deque>
+#include <mutex>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "emulators/field2d/counter_hash.h"
 #include "emulators/field2d/leaf_raster.h"
@@ -20,9 +24,16 @@ namespace {
 // ground) touches some 40 of them.
 constexpr int kTileShift = 8;
 constexpr int kTileCells = 1 << kTileShift;
+// A tile's row as bits: four 64-bit words.
+constexpr int kWordShift = 6;
+constexpr int kTileWords = kTileCells >> kWordShift;
+static_assert(CropCoverMap::kCellsPerWord == 1 << kWordShift);
 constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
-// Beyond this many cached tiles (64 KiB each) the cache starts again: tiles
-// are pure functions of the seed, so dropping them changes nothing but time.
+// At this many cached tiles (72 KiB each) the older half is dropped: tiles
+// are pure functions of the seed, so dropping them changes nothing but time,
+// and the oldest are those a boom driving on has left behind (dropping them
+// all rebuilt the two cameras' and the judge's current views, some 100
+// tiles, once every 1024).
 constexpr std::size_t kMaxCachedTiles = 1024;
 // Plants are drawn per row cell of this length along the row.
 constexpr double kRowCellM = 0.25;
@@ -76,20 +87,67 @@ bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
     return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
 }
 
-// The plant cells among 8 cells (each kPlantCell or 0): one bit of each byte
-// summed into the top byte by a multiply (at most 8, no carries between bytes).
-int plant_cells_in_8(const std::uint8_t* cells) {
-    std::uint64_t word = 0;
-    std::memcpy(&word, cells, sizeof word);
-    return static_cast<int>(((word & 0x0101010101010101ULL) * 0x0101010101010101ULL) >> 56);
+// The plant cells of a row's bits from cell `from` up to (not including) `to`.
+int plant_bits_in(const std::uint64_t* words, int from, int to) {
+    int plant = 0;
+    while (from < to) {
+        const int word = from >> kWordShift;
+        const int low = from & 63;
+        const int high = std::min(to - (word << kWordShift), 64);  // one past the last bit counted
+        const std::uint64_t below_high = high == 64 ? ~0ULL : (1ULL << high) - 1ULL;
+        plant += std::popcount(words[word] & below_high & (~0ULL << low));
+        from = (word << kWordShift) + high;
+    }
+    return plant;
 }
 
-int plant_cells_in(const std::uint8_t* cells, std::size_t count) {
-    int plant = 0;
-    std::size_t i = 0;
-    for (; i + 8 <= count; i += 8) plant += plant_cells_in_8(cells + i);
-    for (; i < count; ++i) plant += cells[i] != 0 ? 1 : 0;
-    return plant;
+// The tile's bytes as bits (bit k of a word is the byte at k: 8 bytes at a
+// time, each 0 or kPlantCell, their top bits gathered by one multiply).
+void pack_bits(const std::uint8_t* cells, std::uint64_t* words, int count) {
+    for (int w = 0; w < count / 64; ++w) {
+        std::uint64_t word = 0;
+        for (int k = 0; k < 8; ++k) {
+            std::uint64_t eight = 0;
+            std::memcpy(&eight, cells + 64 * w + 8 * k, sizeof eight);
+            // Byte b's top bit (bit 8b + 7) lands at bit 56 + b; no two products overlap below it.
+            const std::uint64_t byte_bits = ((eight & 0x8080808080808080ULL) * 0x0002040810204081ULL) >> 56;
+            word |= byte_bits << (8 * k);
+        }
+        words[w] = word;
+    }
+}
+
+// One row of one tile's part of a block of cells: where it lies in the
+// block (row, first column) and in the tile, and how many cells it has.
+struct TileRow {
+    std::size_t block_row;
+    std::size_t block_col;
+    std::size_t tile_row;
+    std::size_t tile_col;
+    std::size_t cells;
+};
+
+// Each tile's rows within the block of cols x rows cells from (east_cell,
+// north_cell), the tile from tile_at(tile_east, tile_north).
+template <typename TileAt, typename EachRow>
+void for_each_tile_row(std::int64_t east_cell, std::int64_t north_cell, std::int64_t cols, std::int64_t rows, const TileAt& tile_at,
+                       const EachRow& each_row) {
+    const std::int64_t east_end = east_cell + cols;
+    const std::int64_t north_end = north_cell + rows;
+    for (std::int64_t tile_north = north_cell >> kTileShift; tile_north * kTileCells < north_end; ++tile_north) {
+        const std::int64_t j_first = std::max(north_cell, tile_north * kTileCells);
+        const std::int64_t j_end = std::min(north_end, (tile_north + 1) * kTileCells);
+        for (std::int64_t tile_east = east_cell >> kTileShift; tile_east * kTileCells < east_end; ++tile_east) {
+            const std::int64_t i_first = std::max(east_cell, tile_east * kTileCells);
+            const std::int64_t i_end = std::min(east_end, (tile_east + 1) * kTileCells);
+            const auto& tile = tile_at(tile_east, tile_north);
+            for (std::int64_t j = j_first; j < j_end; ++j) {
+                each_row(tile, TileRow{static_cast<std::size_t>(j - north_cell), static_cast<std::size_t>(i_first - east_cell),
+                                       static_cast<std::size_t>(j - tile_north * kTileCells),
+                                       static_cast<std::size_t>(i_first - tile_east * kTileCells), static_cast<std::size_t>(i_end - i_first)});
+            }
+        }
+    }
 }
 
 }  // namespace
@@ -97,6 +155,41 @@ int plant_cells_in(const std::uint8_t* cells, std::size_t count) {
 struct CropCoverMap::Tile {
     // kPlantCell or 0 per cell, row-major from the tile's south-west cell.
     std::vector<std::uint8_t> plant = std::vector<std::uint8_t>(static_cast<std::size_t>(kTileCells) * kTileCells, 0);
+    // The same, a bit a cell (kTileWords words a row), for cover counts and copy_cell_bits().
+    std::vector<std::uint64_t> bits = std::vector<std::uint64_t>(static_cast<std::size_t>(kTileWords) * kTileCells, 0);
+};
+
+// Built tiles by key, at most kMaxCachedTiles, the older half dropped when full.
+class CropCoverMap::TileCache {
+public:
+    const Tile* find(std::uint64_t key) const {
+        const auto found = tiles_.find(key);
+        return found == tiles_.end() ? nullptr : found->second.get();
+    }
+    // The tile stored under `key`: `tile` unless one was there already.
+    // Makes room first, so pointers find() gave before may dangle.
+    const Tile* insert(std::uint64_t key, std::shared_ptr<const Tile> tile) {
+        if (const Tile* held = find(key)) return held;
+        if (tiles_.size() >= kMaxCachedTiles) {
+            const std::size_t dropped = order_.size() / 2;
+            for (std::size_t k = 0; k < dropped; ++k) tiles_.erase(order_[k]);
+            order_.erase(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(dropped));
+        }
+        order_.push_back(key);
+        return tiles_.emplace(key, std::move(tile)).first->second.get();
+    }
+    // The shared pointer stored under `key` (one find() has found).
+    std::shared_ptr<const Tile> share(std::uint64_t key) const { return tiles_.at(key); }
+    std::size_t size() const { return tiles_.size(); }
+
+private:
+    std::unordered_map<std::uint64_t, std::shared_ptr<const Tile>> tiles_;
+    std::deque<std::uint64_t> order_;  // tiles_'s keys, oldest first
+};
+
+struct CropCoverMap::SharedTiles {
+    std::mutex mutex;
+    TileCache tiles;
 };
 
 const char* cover_class_name(CoverClass cover) {
@@ -126,9 +219,22 @@ void validate(const CropCoverParams& p) {
 }
 
 CropCoverMap::CropCoverMap(CropCoverParams params, std::uint64_t seed)
-    : params_(std::move(params)), seed_(seed), identity_(next_map_identity()) {
+    : params_(std::move(params)),
+      seed_(seed),
+      identity_(next_map_identity()),
+      shared_(std::make_shared<SharedTiles>()),
+      tiles_(std::make_unique<TileCache>()) {
     validate(params_);
 }
+
+CropCoverMap::CropCoverMap(const CropCoverMap& other, std::shared_ptr<SharedTiles> shared)
+    : params_(other.params_),
+      seed_(other.seed_),
+      identity_(next_map_identity()),
+      shared_(std::move(shared)),
+      tiles_(std::make_unique<TileCache>()) {}
+
+CropCoverMap CropCoverMap::sharing_tiles() const { return CropCoverMap(*this, shared_); }
 CropCoverMap::~CropCoverMap() = default;
 CropCoverMap::CropCoverMap(CropCoverMap&&) noexcept = default;
 CropCoverMap& CropCoverMap::operator=(CropCoverMap&&) noexcept = default;
@@ -159,17 +265,31 @@ bool CropCoverMap::is_plant(Vec2 ground) const {
     return t.plant[j * kTileCells + i] != 0;
 }
 
+std::size_t CropCoverMap::cached_tile_count() const { return tiles_->size(); }
+
 const CropCoverMap::Tile& CropCoverMap::tile(std::int64_t tile_east, std::int64_t tile_north) const {
     const std::uint64_t key = tile_key(tile_east, tile_north);
     if (last_tile_ != nullptr && key == last_key_) return *last_tile_;
-    auto found = tiles_.find(key);
-    if (found == tiles_.end()) {
-        if (tiles_.size() >= kMaxCachedTiles) tiles_.clear();
-        auto fresh = std::make_unique<Tile>();
-        rasterise(*fresh, tile_east, tile_north);
-        found = tiles_.emplace(key, std::move(fresh)).first;
+    const Tile* found = tiles_->find(key);
+    if (found == nullptr) {
+        std::shared_ptr<const Tile> shared;
+        {
+            const std::lock_guard lock(shared_->mutex);
+            if (shared_->tiles.find(key) != nullptr) shared = shared_->tiles.share(key);
+        }
+        if (!shared) {
+            // Built outside the lock (another map's thread may build the same
+            // tile meanwhile: the same cells, and the first one stored is kept).
+            auto fresh = std::make_shared<Tile>();
+            rasterise(*fresh, tile_east, tile_north);
+            pack_bits(fresh->plant.data(), fresh->bits.data(), kTileCells * kTileCells);
+            const std::lock_guard lock(shared_->mutex);
+            shared_->tiles.insert(key, std::move(fresh));
+            shared = shared_->tiles.share(key);
+        }
+        found = tiles_->insert(key, std::move(shared));
     }
-    last_tile_ = found->second.get();
+    last_tile_ = found;
     last_key_ = key;
     return *last_tile_;
 }
@@ -321,8 +441,8 @@ std::int64_t CropCoverMap::plant_cells_in_row(std::int64_t north_cell, std::int6
         const std::int64_t from = std::max(east_first, tile_east * kTileCells);
         const std::int64_t to = std::min(east_end, (tile_east + 1) * kTileCells);
         const Tile& t = tile(tile_east, tile_north);
-        plant += plant_cells_in(t.plant.data() + j * kTileCells + static_cast<std::size_t>(from - tile_east * kTileCells),
-                                static_cast<std::size_t>(to - from));
+        plant += plant_bits_in(t.bits.data() + j * kTileWords, static_cast<int>(from - tile_east * kTileCells),
+                               static_cast<int>(to - tile_east * kTileCells));
     }
     return plant;
 }
@@ -337,23 +457,29 @@ void CropCoverMap::copy_cells(std::int64_t east_cell, std::int64_t north_cell, i
                                     std::to_string(east_cell) + ", " + std::to_string(north_cell) +
                                     ") mm is empty or reaches 1000 km or more from the origin");
     }
-    const std::int64_t east_end = east_cell + cols;
-    const std::int64_t north_end = north_cell + rows;
-    for (std::int64_t tile_north = north_cell >> kTileShift; tile_north * kTileCells < north_end; ++tile_north) {
-        const std::int64_t j_first = std::max(north_cell, tile_north * kTileCells);
-        const std::int64_t j_end = std::min(north_end, (tile_north + 1) * kTileCells);
-        for (std::int64_t tile_east = east_cell >> kTileShift; tile_east * kTileCells < east_end; ++tile_east) {
-            const std::int64_t i_first = std::max(east_cell, tile_east * kTileCells);
-            const std::int64_t i_end = std::min(east_end, (tile_east + 1) * kTileCells);
-            const Tile& t = tile(tile_east, tile_north);
-            for (std::int64_t j = j_first; j < j_end; ++j) {
-                const std::uint8_t* from = t.plant.data() + static_cast<std::size_t>(j - tile_north * kTileCells) * kTileCells +
-                                           static_cast<std::size_t>(i_first - tile_east * kTileCells);
-                std::uint8_t* to = out + static_cast<std::size_t>(j - north_cell) * stride + static_cast<std::size_t>(i_first - east_cell);
-                std::memcpy(to, from, static_cast<std::size_t>(i_end - i_first));
-            }
-        }
+    for_each_tile_row(east_cell, north_cell, cols, rows, [this](std::int64_t east, std::int64_t north) -> const Tile& { return tile(east, north); },
+                      [&](const Tile& t, const TileRow& row) {
+                          std::memcpy(out + row.block_row * stride + row.block_col, t.plant.data() + row.tile_row * kTileCells + row.tile_col,
+                                      row.cells);
+                      });
+}
+
+void CropCoverMap::copy_cell_bits(std::int64_t east_cell, std::int64_t north_cell, int words_per_row, int rows, std::uint64_t* out,
+                                  std::size_t stride_words) const {
+    const std::int64_t cols = static_cast<std::int64_t>(words_per_row) * kCellsPerWord;
+    if (words_per_row <= 0 || rows <= 0 || east_cell % kCellsPerWord != 0 || east_cell <= -kMaxCellIndex ||
+        east_cell + cols >= kMaxCellIndex || north_cell <= -kMaxCellIndex || north_cell + rows >= kMaxCellIndex) {
+        throw std::invalid_argument("crop copy_cell_bits: " + std::to_string(words_per_row) + " words x " + std::to_string(rows) +
+                                    " rows of cells from (" + std::to_string(east_cell) + ", " + std::to_string(north_cell) +
+                                    ") mm is empty, reaches 1000 km or more from the origin or starts off a multiple of 64 cells east");
     }
+    // Whole words: east_cell and the tiles' edges are multiples of 64.
+    for_each_tile_row(east_cell, north_cell, cols, rows, [this](std::int64_t east, std::int64_t north) -> const Tile& { return tile(east, north); },
+                      [&](const Tile& t, const TileRow& row) {
+                          std::memcpy(out + row.block_row * stride_words + (row.block_col >> kWordShift),
+                                      t.bits.data() + row.tile_row * kTileWords + (row.tile_col >> kWordShift),
+                                      (row.cells >> kWordShift) * sizeof(std::uint64_t));
+                      });
 }
 
 std::array<Vec2, 4> nozzle_roi_ground(Vec2 boom_centre_ground, double heading_deg, double nozzle_right_m, double width_m,

@@ -23,12 +23,12 @@
 // Reproducible: every plant is drawn from a counter-based hash of (seed, row,
 // row cell), so the field is the same whatever order it is looked at in and
 // needs no storage up front; the raster is built in tiles on first use and
-// cached (the class is therefore not safe to share between threads).
+// cached (the class is therefore not safe to share between threads; maps
+// made by sharing_tiles() share the tiles safely).
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "emulators/field2d/polygon.h"
@@ -109,16 +109,37 @@ public:
     // or more from the origin.
     void copy_cells(std::int64_t east_cell, std::int64_t north_cell, int cols, int rows, std::uint8_t* out,
                     std::size_t stride) const;
+    // Cells a word holds in copy_cell_bits().
+    static constexpr int kCellsPerWord = 64;
+    // The same block as copy_cells() gives, one bit a cell (an eighth of the
+    // bytes, so a renderer's window of it stays in cache from frame to frame):
+    // words_per_row x kCellsPerWord cells from east_cell, whose bit k of word
+    // w in row r is cell (east_cell + 64 w + k, north_cell + r), 1 where
+    // plant; row r starts at out + r * stride_words. Throws
+    // std::invalid_argument for an empty block, one reaching 1000 km or more
+    // from the origin, or an east_cell that is not a multiple of 64 (the
+    // tiles' words start there).
+    void copy_cell_bits(std::int64_t east_cell, std::int64_t north_cell, int words_per_row, int rows, std::uint64_t* out,
+                        std::size_t stride_words) const;
 
     const CropCoverParams& params() const { return params_; }
     std::uint64_t seed() const { return seed_; }
-    std::size_t cached_tile_count() const { return tiles_.size(); }
+    std::size_t cached_tile_count() const;
     // A number no other map built in this process has (a move hands it on):
     // a renderer keeps a copy of some cells and must know whose they are.
     std::uint64_t identity() const { return identity_; }
 
+    // Another map of the same field that shares this one's built tiles: each
+    // of the two may be used on its own thread (the tiles they share are
+    // built once, under a lock; the rest of each map is its own), so two
+    // cameras over the same ground draw its leaves once.
+    CropCoverMap sharing_tiles() const;
+
 private:
     struct Tile;
+    class TileCache;
+    struct SharedTiles;
+    CropCoverMap(const CropCoverMap& other, std::shared_ptr<SharedTiles> shared);
     const Tile& tile(std::int64_t tile_east, std::int64_t tile_north) const;
     void rasterise(Tile& tile, std::int64_t tile_east, std::int64_t tile_north) const;
     // The plant cells of row north_cell from east_first up to (not including) east_end.
@@ -127,7 +148,8 @@ private:
     CropCoverParams params_;
     std::uint64_t seed_;
     std::uint64_t identity_;
-    mutable std::unordered_map<std::uint64_t, std::unique_ptr<Tile>> tiles_;
+    std::shared_ptr<SharedTiles> shared_;     // with the maps sharing_tiles() made
+    mutable std::unique_ptr<TileCache> tiles_;  // this map's own look-up of them
     mutable const Tile* last_tile_ = nullptr;
     mutable std::uint64_t last_key_ = 0;
 };

@@ -17,7 +17,19 @@ constexpr double kSureM = 1e-9;
 // A leaf within this (as a slope) of square to an axis has that condition of
 // its rectangle independent of x (its bounds would be past 1e9 m).
 constexpr double kFlat = 1e-12;
+constexpr double kCellsPerM = 1000.0;
 constexpr std::uint8_t kPlantCell = 255;
+
+// floor() of a value held within [low, high] first (so it fits an int, and
+// truncation and a correction give the floor without a libm call on the
+// baseline x86-64 target): std::floor(value) clamped to the range.
+int floor_within(double value, int low, int high) {
+    const double held = std::clamp(value, static_cast<double>(low), static_cast<double>(high));
+    const int truncated = static_cast<int>(held);
+    return static_cast<double>(truncated) > held ? truncated - 1 : truncated;
+}
+
+int ceil_within(double value, int low, int high) { return -floor_within(-value, -high, -low); }
 
 // Squared distance from p to the segment a-b.
 double segment_distance_sq(double px, double py, double ax, double ay, double bx, double by) {
@@ -110,7 +122,9 @@ struct Capsule {
 // floor (a libm call on the baseline x86-64 target): truncation's guess is at
 // most a cell off, and the walk puts it right.
 int centre_index_past(double x_m, int first, int end, CentrePast rule) {
-    const double scaled = std::clamp(x_m / kCellM - 0.5, static_cast<double>(first), static_cast<double>(end));
+    // A guess only (a product, not a quotient: the walk below ends on the
+    // first centre past x_m from wherever it starts in [first, end]).
+    const double scaled = std::clamp(x_m * kCellsPerM - 0.5, static_cast<double>(first), static_cast<double>(end));
     auto i = static_cast<int>(scaled);
     auto past = [&](int k) {
         const double centre = (static_cast<double>(k) + 0.5) * kCellM;
@@ -157,8 +171,8 @@ void draw_leaf(std::uint8_t* cells, int side, const LeafStrip& leaf) {
         // any) take the exact test.
         const auto [sure, maybe] = leaf_shape.slices(cy, half_width - kSureM, half_width + kSureM);
         if (maybe.low > maybe.high || maybe.high < 0.0 || maybe.low > side_m) continue;
-        const int i_first = std::max(0, static_cast<int>(std::floor(maybe.low / kCellM - 0.5)));
-        const int i_end = std::min(side - 1, static_cast<int>(std::ceil(maybe.high / kCellM - 0.5))) + 1;
+        const int i_first = floor_within(maybe.low / kCellM - 0.5, 0, side);
+        const int i_end = ceil_within(maybe.high / kCellM - 0.5, -1, side - 1) + 1;
         if (i_first >= i_end) continue;
         std::uint8_t* row = cells + static_cast<std::size_t>(j) * static_cast<std::size_t>(side);
         auto exact = [&](int from, int to) {
@@ -174,8 +188,16 @@ void draw_leaf(std::uint8_t* cells, int side, const LeafStrip& leaf) {
             exact(maybe_first, maybe_end);
             continue;
         }
-        const int sure_first = std::max(maybe_first, centre_index_past(sure.low, i_first, i_end, CentrePast::strictly_right));
-        const int sure_end = std::min(maybe_end, std::max(sure_first, centre_index_past(sure.high, i_first, i_end, CentrePast::at_or_right)));
+        // Mostly the sure run starts and ends where the maybe run does: its
+        // first cell's centre is right of sure.low (so no centre from
+        // i_first on is first past it later) and its last one's left of
+        // sure.high (so none before maybe_end reaches it); only else walk.
+        const bool starts_sure = maybe_first == i_end || cell_centre_m(maybe_first) > sure.low;
+        const int sure_first =
+            starts_sure ? maybe_first : std::max(maybe_first, centre_index_past(sure.low, i_first, i_end, CentrePast::strictly_right));
+        const bool ends_sure = maybe_end > sure_first && cell_centre_m(maybe_end - 1) < sure.high;
+        const int sure_end = ends_sure ? maybe_end
+                                       : std::min(maybe_end, std::max(sure_first, centre_index_past(sure.high, i_first, i_end, CentrePast::at_or_right)));
         exact(maybe_first, sure_first);
         if (sure_end > sure_first) std::memset(row + sure_first, kPlantCell, static_cast<std::size_t>(sure_end - sure_first));
         exact(sure_end, maybe_end);

@@ -37,6 +37,7 @@ constexpr std::int64_t kWindowMarginCells = 500;
 // A map coordinate that sees no ground is clamped here (relative to the boom
 // centre's cell), so it stays a finite 16-bit number after the window's offset.
 constexpr float kFarCells = 16'000.0F;
+static_assert(kFarCells < 32'768.0F && kMaxWindowSide + 2 * 64 < 32'768, "rows and the bits' row length fit 16 bits (sample_row_nearest)");
 // Rows of samples render() works through at a time: 2^16 samples, a band that
 // stays in cache and that OpenCV does on the calling thread (it splits a call
 // into stripes of 2^16 pixels; one stripe runs where it was called).
@@ -116,13 +117,26 @@ LitColours lit_colours(const CameraEmulatorParams& params) {
 // The colour table's entry for pixels whose rays miss the ground.
 constexpr int kSkyEntry = 256;
 
-// The block of the crop truth a frame's samples read, from the view's first cell.
-struct CoverView {
-    const std::uint8_t* cells = nullptr;
-    std::size_t step = 0;  // cells from one row to the next
+// The block of the crop truth a one-sample frame's samples read, a bit a
+// cell (CropCoverMap::copy_cell_bits), from the view's first cell: cell
+// (col, row) of the view, 0 <= col < cols and 0 <= row < rows_held, is bit
+// row * bits_per_row + first_col + col counted from `words` (bit k of a word
+// is its k-th); bit zero_bit is in a word of soil past the window.
+struct CoverBitsView {
+    const std::uint64_t* words = nullptr;
+    int bits_per_row = 0;
+    int first_col = 0;
     int cols = 0;
-    int rows = 0;
+    int rows_held = 0;
+    int zero_bit = 0;
 };
+
+// A bit of the view as a cover byte: 0 or kPlantCell (the byte copy_cells() has there).
+std::uint8_t cover_of_bit(const std::uint64_t* words, int bit) {
+    static_assert(CropCoverMap::kPlantCell == 255, "a plant bit reads as all eight bits set");
+    const auto at = static_cast<unsigned>(bit);
+    return static_cast<std::uint8_t>(0U - static_cast<unsigned>((words[at / 64U] >> (at % 64U)) & 1U));
+}
 
 // One row of one-sample pixels: each pixel centre's undistorted point
 // (x, y) through the homography h (row-major) to the view's cells, and the
@@ -130,17 +144,24 @@ struct CoverView {
 // fixed-point remap's on single-precision maps: the point in single
 // precision, ((h0 x + h1 y) + h2) / depth with the depth held below the
 // horizon, clamped to +-kFarCells, rounded to the nearest cell (ties to
-// even, as cvRound), then the nearest cell read. Four pixels at a time.
-void sample_row_nearest(const float* xs, const float* ys, int width, const float h[9], const CoverView& view, std::uint8_t* out) {
+// even, as cvRound), then the nearest cell read. The cells' bit numbers
+// four pixels at a time, without a branch (a cell outside the view reads the
+// soil word past it), into `bits` (width values); then the reads, none
+// waiting on another.
+void sample_row_nearest(const float* xs, const float* ys, int width, const float h[9], const CoverBitsView& view, int* bits,
+                        std::uint8_t* out) {
     const cv::v_float32x4 h00 = cv::v_setall_f32(h[0]), h01 = cv::v_setall_f32(h[1]), h02 = cv::v_setall_f32(h[2]);
     const cv::v_float32x4 h10 = cv::v_setall_f32(h[3]), h11 = cv::v_setall_f32(h[4]), h12 = cv::v_setall_f32(h[5]);
     const cv::v_float32x4 h20 = cv::v_setall_f32(h[6]), h21 = cv::v_setall_f32(h[7]), h22 = cv::v_setall_f32(h[8]);
     const cv::v_float32x4 horizon = cv::v_setall_f32(-1e-6F);
     const cv::v_float32x4 far_low = cv::v_setall_f32(-kFarCells), far_high = cv::v_setall_f32(kFarCells);
-    auto read = [&view](int col, int row) -> std::uint8_t {
-        if (static_cast<unsigned>(col) >= static_cast<unsigned>(view.cols) || static_cast<unsigned>(row) >= static_cast<unsigned>(view.rows)) return 0;
-        return view.cells[static_cast<std::size_t>(row) * view.step + static_cast<std::size_t>(col)];
-    };
+    const cv::v_int32x4 zero = cv::v_setzero_s32();
+    const cv::v_int32x4 cols_held = cv::v_setall_s32(view.cols), rows_held = cv::v_setall_s32(view.rows_held);
+    // Each 32-bit lane (bits_per_row, 0) as 16-bit halves: a row (clamped to
+    // +-kFarCells, so it fits 16 bits) times it is one multiply-add of halves.
+    const cv::v_int16x8 bits_per_row = cv::v_reinterpret_as_s16(cv::v_setall_s32(view.bits_per_row));
+    const cv::v_int32x4 first_col = cv::v_setall_s32(view.first_col);
+    const cv::v_int32x4 soil_bit = cv::v_setall_s32(view.zero_bit);
     int u = 0;
     for (; u + 4 <= width; u += 4) {
         const cv::v_float32x4 x = cv::v_load(xs + u);
@@ -148,27 +169,49 @@ void sample_row_nearest(const float* xs, const float* ys, int width, const float
         const cv::v_float32x4 depth = cv::v_min(h20 * x + h21 * y + h22, horizon);
         const cv::v_int32x4 col = cv::v_round(cv::v_min(cv::v_max((h00 * x + h01 * y + h02) / depth, far_low), far_high));
         const cv::v_int32x4 row = cv::v_round(cv::v_min(cv::v_max((h10 * x + h11 * y + h12) / depth, far_low), far_high));
-        int cols[4];
-        int rows[4];
-        cv::v_store(cols, col);
-        cv::v_store(rows, row);
-        for (int k = 0; k < 4; ++k) out[u + k] = read(cols[k], rows[k]);
+        const cv::v_int32x4 inside = (col >= zero) & (col < cols_held) & (row >= zero) & (row < rows_held);
+        const cv::v_int32x4 row_start = cv::v_dotprod(cv::v_reinterpret_as_s16(row), bits_per_row);
+        cv::v_store(bits + u, cv::v_select(inside, row_start + first_col + col, soil_bit));
     }
     for (; u < width; ++u) {
         const float depth = std::min(h[6] * xs[u] + h[7] * ys[u] + h[8], -1e-6F);
-        const float col = std::min(std::max((h[0] * xs[u] + h[1] * ys[u] + h[2]) / depth, -kFarCells), kFarCells);
-        const float row = std::min(std::max((h[3] * xs[u] + h[4] * ys[u] + h[5]) / depth, -kFarCells), kFarCells);
-        out[u] = read(cvRound(col), cvRound(row));
+        const int col = cvRound(std::min(std::max((h[0] * xs[u] + h[1] * ys[u] + h[2]) / depth, -kFarCells), kFarCells));
+        const int row = cvRound(std::min(std::max((h[3] * xs[u] + h[4] * ys[u] + h[5]) / depth, -kFarCells), kFarCells));
+        const bool inside = static_cast<unsigned>(col) < static_cast<unsigned>(view.cols) &&
+                            static_cast<unsigned>(row) < static_cast<unsigned>(view.rows_held);
+        bits[u] = inside ? row * view.bits_per_row + view.first_col + col : view.zero_bit;
     }
+    for (u = 0; u < width; ++u) out[u] = cover_of_bit(view.words, bits[u]);
 }
 
 // One row of the frame from its pixels' cover (0 soil .. 255 plant): each
 // pixel's colour from the table (sky where `sky` is set), plus its noise (if
 // any), both in 1/64 DN and summed saturating at 16 bits, then rounded to a
 // DN (ties to even) and clipped to 0-255. `lit` holds 3 x width + 1 values.
+// With `two_levels` every cover is 0 or 255 (one sample a pixel) and the
+// colours are picked eight pixels at a time.
 void colour_row(const std::uint8_t* cover, const std::uint8_t* sky, const std::int16_t* table, const std::int16_t* noise, int width,
-                std::int16_t* lit, std::uint8_t* out) {
-    for (int u = 0; u < width; ++u) {
+                bool two_levels, std::int16_t* lit, std::uint8_t* out) {
+    int lit_pixels = 0;
+    if (two_levels) {
+        auto channel = [table](int entry, int c) { return cv::v_setall_u16(static_cast<std::uint16_t>(table[4 * entry + c])); };
+        const cv::v_uint16x8 soil[3] = {channel(0, 0), channel(0, 1), channel(0, 2)};
+        const cv::v_uint16x8 plant[3] = {channel(255, 0), channel(255, 1), channel(255, 2)};
+        const cv::v_uint16x8 sky_colour[3] = {channel(kSkyEntry, 0), channel(kSkyEntry, 1), channel(kSkyEntry, 2)};
+        const cv::v_uint16x8 zero = cv::v_setzero_u16();
+        for (; lit_pixels + 8 <= width; lit_pixels += 8) {
+            const cv::v_uint16x8 is_plant = cv::v_load_expand(cover + lit_pixels) != zero;
+            cv::v_uint16x8 rgb[3];
+            for (int c = 0; c < 3; ++c) rgb[c] = cv::v_select(is_plant, plant[c], soil[c]);
+            if (sky != nullptr) {
+                const cv::v_uint16x8 is_sky = cv::v_load_expand(sky + lit_pixels) != zero;
+                for (int c = 0; c < 3; ++c) rgb[c] = cv::v_select(is_sky, sky_colour[c], rgb[c]);
+            }
+            // The table's values are 0..32767: the same bits as int16.
+            cv::v_store_interleave(reinterpret_cast<std::uint16_t*>(lit + 3 * lit_pixels), rgb[0], rgb[1], rgb[2]);
+        }
+    }
+    for (int u = lit_pixels; u < width; ++u) {
         const int entry = sky != nullptr && sky[u] != 0 ? kSkyEntry : cover[u];
         std::memcpy(lit + 3 * u, table + 4 * entry, 4 * sizeof(std::int16_t));  // the fourth is overwritten by the next pixel
     }
@@ -338,9 +381,9 @@ Eigen::Matrix3d CameraEmulator::normalized_to_ground_cells(const BoomPose& pose,
 }
 
 void CameraEmulator::hold_cells(const CropCoverMap& crop, std::int64_t east_first, std::int64_t east_last, std::int64_t north_first,
-                                std::int64_t north_last) const {
+                                std::int64_t north_last, CellForm form) const {
     CoverWindow& w = window_;
-    if (w.crop_identity == crop.identity() && east_first >= w.east_cell && north_first >= w.north_cell &&
+    if (w.crop_identity == crop.identity() && w.form == form && east_first >= w.east_cell && north_first >= w.north_cell &&
         east_last < w.east_cell + w.cols && north_last < w.north_cell + w.rows) {
         return;
     }
@@ -352,12 +395,24 @@ void CameraEmulator::hold_cells(const CropCoverMap& crop, std::int64_t east_firs
         margin /= 2;
     }
     w.crop_identity = 0;  // holds nothing until the copy below has finished
-    w.east_cell = east_first - margin;
+    w.form = form;
     w.north_cell = north_first - margin;
-    w.cols = static_cast<int>(cols + 2 * margin);
     w.rows = static_cast<int>(rows + 2 * margin);
-    w.cells.resize(static_cast<std::size_t>(w.cols) * static_cast<std::size_t>(w.rows));
-    crop.copy_cells(w.east_cell, w.north_cell, w.cols, w.rows, w.cells.data(), static_cast<std::size_t>(w.cols));
+    if (form == CellForm::bytes) {
+        w.east_cell = east_first - margin;
+        w.cols = static_cast<int>(cols + 2 * margin);
+        w.cells.resize(static_cast<std::size_t>(w.cols) * static_cast<std::size_t>(w.rows));
+        crop.copy_cells(w.east_cell, w.north_cell, w.cols, w.rows, w.cells.data(), static_cast<std::size_t>(w.cols));
+    } else {
+        // Whole words from a multiple of 64 cells (copy_cell_bits' words start there).
+        constexpr std::int64_t word = CropCoverMap::kCellsPerWord;
+        const std::int64_t east_low = east_first - margin;
+        w.east_cell = (east_low >= 0 ? east_low : east_low - (word - 1)) / word * word;
+        const std::int64_t words = (east_last + margin + 1 - w.east_cell + word - 1) / word;
+        w.cols = static_cast<int>(words * word);
+        w.bits.assign(static_cast<std::size_t>(words) * static_cast<std::size_t>(w.rows) + 1U, 0);  // + a soil word past the last row
+        crop.copy_cell_bits(w.east_cell, w.north_cell, static_cast<int>(words), w.rows, w.bits.data(), static_cast<std::size_t>(words));
+    }
     w.crop_identity = crop.identity();
 }
 
@@ -415,7 +470,8 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
         view_east = centre_east + std::floor(east_min) - 1.0;
         view_north = centre_north + std::floor(north_min) - 1.0;
         hold_cells(crop, static_cast<std::int64_t>(view_east), static_cast<std::int64_t>(view_east + cols - 1.0),
-                   static_cast<std::int64_t>(view_north), static_cast<std::int64_t>(view_north + rows - 1.0));
+                   static_cast<std::int64_t>(view_north), static_cast<std::int64_t>(view_north + rows - 1.0),
+                   params_.samples_per_axis == 1 ? CellForm::bits : CellForm::bytes);
     }
     // The maps count from the view's first cell, a function of the pose alone:
     // a frame's bytes do not depend on where the window happens to lie.
@@ -446,17 +502,27 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
     const int noise_v = static_cast<int>((frame_key >> 32) % kNoiseShifts);
     const std::size_t noise_row_values = 3U * static_cast<std::size_t>(width + kNoiseShifts - 1);
     // The maps count from the view's first cell: the samples read the window from there.
-    CoverView view;
+    CoverBitsView bits_view;
     cv::Mat view_mat;
     if (sees_ground) {
         const auto first_col = static_cast<std::size_t>(static_cast<std::int64_t>(view_east) - window_.east_cell);
         const auto first_row = static_cast<std::size_t>(static_cast<std::int64_t>(view_north) - window_.north_cell);
-        view.cells = window_.cells.data() + first_row * static_cast<std::size_t>(window_.cols) + first_col;
-        view.step = static_cast<std::size_t>(window_.cols);
-        view.cols = window_.cols - static_cast<int>(first_col);
-        view.rows = window_.rows - static_cast<int>(first_row);
-        // A header over the window, only read (OpenCV has no const Mat over const data).
-        view_mat = cv::Mat(view.rows, view.cols, CV_8UC1, const_cast<std::uint8_t*>(view.cells), view.step);
+        const int view_cols = window_.cols - static_cast<int>(first_col);
+        const int view_rows = window_.rows - static_cast<int>(first_row);
+        if (window_.form == CellForm::bits) {
+            // Bit numbers fit an int: the window holds at most kMaxWindowCells cells (and a word a row).
+            const auto words_per_row = static_cast<std::size_t>(window_.cols / CropCoverMap::kCellsPerWord);
+            bits_view.words = window_.bits.data() + first_row * words_per_row;
+            bits_view.bits_per_row = window_.cols;
+            bits_view.first_col = static_cast<int>(first_col);
+            bits_view.cols = view_cols;
+            bits_view.rows_held = view_rows;
+            bits_view.zero_bit = view_rows * window_.cols;  // the soil word after the window's last row
+        } else {
+            // A header over the window, only read (OpenCV has no const Mat over const data).
+            view_mat = cv::Mat(view_rows, view_cols, CV_8UC1, window_.cells.data() + first_row * static_cast<std::size_t>(window_.cols) + first_col,
+                               static_cast<std::size_t>(window_.cols));
+        }
     }
 
     const int n = params_.samples_per_axis;
@@ -468,7 +534,7 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
         const std::int16_t* noise =
             noise_.empty() ? nullptr
                            : noise_.data() + static_cast<std::size_t>(noise_v + v) * noise_row_values + 3U * static_cast<std::size_t>(noise_u);
-        colour_row(cover, sky, colour_table.data(), noise, width, lit_row.data(),
+        colour_row(cover, sky, colour_table.data(), noise, width, n == 1, lit_row.data(),
                    image.bytes.data() + static_cast<std::size_t>(v) * 3U * pixels_per_row);
     };
     if (!sees_ground) {
@@ -476,9 +542,10 @@ std::optional<RgbImage> CameraEmulator::render(const CropCoverMap& crop, const B
         for (int v = 0; v < height; ++v) finish_row(v, cover_row.data());
     } else if (n == 1) {
         const float h_rows[9] = {h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2), h(2, 0), h(2, 1), h(2, 2)};
+        std::vector<int> bit_row(pixels_per_row);
         for (int v = 0; v < height; ++v) {
             const std::size_t first = static_cast<std::size_t>(v) * pixels_per_row;
-            sample_row_nearest(centre_x_.data() + first, centre_y_.data() + first, width, h_rows, view, cover_row.data());
+            sample_row_nearest(centre_x_.data() + first, centre_y_.data() + first, width, h_rows, bits_view, bit_row.data(), cover_row.data());
             finish_row(v, cover_row.data());
         }
     } else {

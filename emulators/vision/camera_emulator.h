@@ -177,10 +177,14 @@ private:
     // ground at `pose`, in the crop truth's cells (cell i's centre at i) less
     // (east_origin, north_origin).
     Eigen::Matrix3d normalized_to_ground_cells(const BoomPose& pose, double east_origin, double north_origin) const;
+    // How the window holds the cells: a byte a cell (0 or kPlantCell, what
+    // OpenCV's remap reads with n x n samples) or a bit a cell (one sample:
+    // an eighth of the memory, so a frame's reads stay in cache).
+    enum class CellForm { bytes, bits };
     // Refills window_ (with a margin) unless it holds cells [east_first,
-    // east_last] x [north_first, north_last] of `crop` already.
+    // east_last] x [north_first, north_last] of `crop` already, in `form`.
     void hold_cells(const rig::field2d::CropCoverMap& crop, std::int64_t east_first, std::int64_t east_last,
-                    std::int64_t north_first, std::int64_t north_last) const;
+                    std::int64_t north_first, std::int64_t north_last, CellForm form) const;
     // With n x n samples a pixel (n > 1): the frame's cover (0 soil .. 255
     // plant), the mean of each pixel's samples, a band of rows at a time,
     // handed to each_band with the band's first row.
@@ -218,11 +222,13 @@ private:
     // The block of the crop's truth render() samples.
     struct CoverWindow {
         std::uint64_t crop_identity = 0;  // 0: holds nothing
+        CellForm form = CellForm::bytes;
         std::int64_t east_cell = 0;
         std::int64_t north_cell = 0;
         int cols = 0;
         int rows = 0;
-        std::vector<std::uint8_t> cells;
+        std::vector<std::uint8_t> cells;    // CellForm::bytes: cols a row
+        std::vector<std::uint64_t> bits;    // CellForm::bits: cols / 64 words a row
     };
     mutable CoverWindow window_;
 };

@@ -185,7 +185,7 @@ CameraNode::CameraNode(const field2d::SprayerKinematics& kinematics, const field
       nozzle_right_m_(std::move(nozzle_right_m)),
       frame_rate_hz_(params.frame_rate_hz),
       calibration_until_ns_(calibration_until_ns),
-      render_crop_(crop.params(), crop.seed()),
+      render_crop_(crop.sharing_tiles()),
       clock_(clock) {
     // The operator lays the green board in front of the camera (where it was
     // designed to sit: a turned camera sees it turned) and a red board over

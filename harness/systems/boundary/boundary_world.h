@@ -182,7 +182,7 @@ private:
     double frame_rate_hz_;
     TimeNs calibration_until_ns_;
     emulators::vision::CalibrationBoards boards_;
-    field2d::CropCoverMap render_crop_;  // the rendering thread's own copy of the crop truth
+    field2d::CropCoverMap render_crop_;  // the rendering thread's own map of the crop truth (tiles shared with the other camera)
     ClockMode clock_;
     // How far ahead frames are rendered: enough to ride out the rendering
     // thread losing its CPU for a while on a busy machine (rig/runtime/work_ahead.h);
