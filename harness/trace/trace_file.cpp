@@ -4,7 +4,6 @@
 
 #include <array>
 #include <charconv>
-#include <cmath>
 #include <iostream>
 #include <stdexcept>
 
@@ -117,14 +116,8 @@ void add_deposition_digest(Sha256& digest, int pass, std::size_t row, int nozzle
     digest.add(' ');
     add_integer(digest, nozzle);
     digest.add(' ');
-    // As nlohmann::json(dose).dump(): null when not finite, else its shortest round-trip digits.
-    if (!std::isfinite(dose_ul_cm2)) {
-        digest.add(std::string_view("null"));
-    } else {
-        std::array<char, 64> text{};
-        const char* end = nlohmann::detail::to_chars(text.data(), text.data() + text.size(), dose_ul_cm2);
-        digest.add(text.data(), static_cast<std::size_t>(end - text.data()));
-    }
+    // The dose as nlohmann::json writes a double (once per cell at the run's end, not on the loop).
+    digest.add(nlohmann::json(dose_ul_cm2).dump());
     digest.add('\n');
 }
 
