@@ -37,7 +37,8 @@ constexpr double kTileM = kTileCells * CropCoverMap::kCellM;
 constexpr std::size_t kMaxCachedTiles = 1024;
 // Plants are drawn per row cell of this length along the row.
 constexpr double kRowCellM = 0.25;
-// A plant reaching the tile by less than this draws nothing on it (rounding is some 1e-18 m here).
+// Added to a plant's reach before asking whether it reaches a tile, so that
+// rounding (some 1e-18 m here) can never leave out a plant that touches it.
 constexpr double kSureM = 1e-9;
 
 // Poisson by inversion of its CDF (mean at most 250 here, so exp(-mean) stays a normal double).

@@ -18,7 +18,6 @@ void validate(const GuidanceParams& p, std::string_view section) {
     check_range(section, "roughness_length_m", p.roughness_length_m, 0.1, 100.0);
     check_range(section, "start_cross_track_m", p.start_cross_track_m, -5.0, 5.0);
     check_range(section, "start_heading_error_deg", p.start_heading_error_deg, -30.0, 30.0);
-    // (0, 0.05]: check_range is closed, so the open end is its own test.
     check_range(section, "step_s", p.step_s, 1e-4, 0.05);
 }
 

@@ -36,8 +36,10 @@ struct GuidanceParams {
     // perfect compensation, 0: none (it steers the antenna itself onto the
     // line). Assumed 0.8: compensation with a lagging, imperfect roll estimate. [0, 1]
     double terrain_compensation = 0.8;
-    // The ground: seeded, first-order (exponentially correlated) processes over
-    // the distance driven, so the same ground excites faster at higher speed.
+    // The ground: seeded random functions of the distance driven, white noise
+    // through two first-order lags of the correlation length (correlation
+    // (1 + d/L) e^(-d/L), ground_roughness.h), so the same ground excites
+    // faster at higher speed.
     // Roll and pitch of the body (it follows the ground, suspension ignored) and
     // a yaw disturbance: the heading change per metre that ruts, clods and
     // wheel slip force on the vehicle (a curvature the steering must cancel).

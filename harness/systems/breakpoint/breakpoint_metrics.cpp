@@ -74,6 +74,9 @@ MetricSet breakpoint_metrics(const std::vector<BreakpointEventSample>& events, c
             // stored (its antenna's offset: 0 on the exact route). On autosteer the
             // body stops some cm off the line; the controller storing where it
             // really was is right, and that offset is the autosteer's, not its error.
+            // A controller's event always has truth at its instant (the recorder
+            // writes a truth sample at every instant the controller publishes);
+            // without one (a hand-made trace) the line is the reference, as before.
             const double true_cross_m = track.antenna_cross_m(event.t_ns).value_or(0.0);
             metrics.values["breakpoint_store_error_m"] = std::hypot(along_m - breakpoint_along_m, cross_m - true_cross_m);
         }
