@@ -22,6 +22,7 @@
 #include "harness/output/atomic_file.h"
 #include "rig/host/cpu_lease.h"
 #include "rig/host/heap_count.h"
+#include "rig/runtime/clock.h"
 #include "rig/runtime/dds_security.h"
 #include "rig/runtime/thread_id_cache.h"
 #include "rig/text/number_text.h"
@@ -35,7 +36,16 @@ struct ModeRuns {
     std::vector<int> repeat_of;  // per run: which repeat (0-based) it belongs to
     std::uint64_t context_switches = 0;  // over all its runs (context_switches_so_far)
     std::uint64_t stepping_allocations = 0;  // over all its runs, while stepping (rig/host/heap_count.h)
+    // Wall time of each whole run, to its trace finished and judged: what a
+    // sweep or a search pays a case (x real time stops before the trace is
+    // finished: its last batch, its index, its log folded back).
+    double whole_wall_s = 0.0;
+    double whole_sim_s = 0.0;
 };
+
+double whole_x_real_time(const ModeRuns& mode) {
+    return mode.whole_wall_s > 0.0 ? mode.whole_sim_s / mode.whole_wall_s : 0.0;
+}
 
 // Context switches, voluntary and not, of every thread of this process and of
 // its children that have ended and been waited for (a case's controller
@@ -254,7 +264,9 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                 const std::vector<CaseInstance> instances = expand_runs({spec}, run_options);
                 const std::uint64_t switches_before = context_switches_so_far();
                 const std::uint64_t allocations_before = stepping_allocations();
+                const WallStopwatch whole;
                 const CaseRun run = run_case(spec, instances.front().seed, instances.front().name, run_options);
+                const double whole_wall_s = whole.elapsed_s();
                 mode.context_switches += context_switches_so_far() - switches_before;
                 mode.stepping_allocations += stepping_allocations() - allocations_before;
                 const CaseResult& result = run.result;
@@ -266,6 +278,8 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                     continue;
                 }
                 digests[result.name].insert(result.trace_sha256);
+                mode.whole_wall_s += whole_wall_s;
+                mode.whole_sim_s += result.sim_seconds;
                 mode.runs.push_back(result);
                 mode.repeat_of.push_back(r);
             }
@@ -342,6 +356,9 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
            "the ping-pong's likewise; vs floor:\n  us/round / the p50 of the ping-pong in the same placement "
            "(process mode: each repeat over the ping-pong\n  measured just before it, the median of those; SIL over "
            "the median one-CPU ping-pong).\n";
+    out << "  x real time to the trace finished and judged (the whole run, as a sweep pays it): process mode "
+        << fixed_text(whole_x_real_time(modes[0]), 1) << ", any CPU " << fixed_text(whole_x_real_time(modes[1]), 1)
+        << ", SIL " << fixed_text(whole_x_real_time(modes[2]), 1) << "\n";
     // Hand-offs: a round trip of the ping-pong against a round (whole runs: start-up and judging included).
     auto per_round = [](std::uint64_t switches, std::uint64_t rounds) {
         return rounds > 0 ? static_cast<double>(switches) / static_cast<double>(rounds) : 0.0;
@@ -407,6 +424,9 @@ int run_speed_bench(const SpeedBenchOptions& options, std::ostream& out, std::os
                      {"trace_bytes_per_sim_minute", f.trace_bytes_per_sim_minute},
                      {"ratio_to_floor", f.us_per_round / std::max(floor_us, 1e-9)}};
     }
+    json["process"]["x_real_time_judged"] = whole_x_real_time(modes[0]);
+    json["process_unpinned"]["x_real_time_judged"] = whole_x_real_time(modes[1]);
+    json["in_process"]["x_real_time_judged"] = whole_x_real_time(modes[2]);
     json["process"]["ratio_to_floor"] = process_ratio;
     json["process"]["ratio_to_floor_per_repeat"] = process_ratios;
     json["process_unpinned"]["ratio_to_floor"] = process_unpinned_ratio;

@@ -1,5 +1,6 @@
 #include "harness/trace/trace_file.h"
 
+#include <pthread.h>
 #include <sqlite3.h>
 
 #include <array>
@@ -13,7 +14,11 @@ namespace rig::harness {
 
 namespace {
 
+// 16 KiB pages, set before anything creates the file: a seed 000 case's
+// samples went into SQLite in 29-34 ms instead of 36-48 ms with 4 KiB ones
+// (fewer pages to split, link and log; docs/speed.md).
 constexpr const char* kSchema = R"sql(
+PRAGMA page_size = 16384;
 PRAGMA journal_mode = WAL;
 PRAGMA synchronous = OFF;
 CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT);
@@ -22,7 +27,6 @@ CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT);
 CREATE TABLE samples (t_ns INTEGER NOT NULL, round INTEGER NOT NULL, topic TEXT NOT NULL, json TEXT NOT NULL,
   cdr BLOB);
 CREATE TABLE sample_types (topic TEXT PRIMARY KEY, type TEXT NOT NULL);
-CREATE INDEX samples_by_topic ON samples (topic, t_ns);
 CREATE VIEW vehicle_truth AS SELECT t_ns / 1e9 AS t_s,
   json_extract(json, '$.along_m') AS antenna_along_m,
   json_extract(json, '$.nozzle_line_along_m') AS nozzle_line_along_m,
@@ -70,6 +74,13 @@ CREATE TABLE foreign_samples (t_ns INTEGER NOT NULL, round INTEGER NOT NULL, top
   participant TEXT NOT NULL, guid_prefix TEXT NOT NULL, json TEXT NOT NULL);
 BEGIN;
 )sql";
+
+// For people's queries by topic (the judge reads the samples in rowid order).
+// Made once the samples are in, when the trace is finished: sorting them once
+// cost less than keeping the index in order row by row as they came (a seed
+// 000 case: about 7 ms at the end against some 15 ms on the writer thread;
+// docs/speed.md). A file whose run was killed has its rows without it.
+constexpr const char* kSamplesIndex = "CREATE INDEX IF NOT EXISTS samples_by_topic ON samples (topic, t_ns);";
 
 // Rows per committed batch: small enough that a killed run loses little, large
 // enough that commits cost nothing measurable.
@@ -154,11 +165,12 @@ TraceFile::TraceFile(const std::filesystem::path& file) : file_(file) {
     }
     set_meta("trace_format", std::to_string(kTraceFormat));
     set_meta("outcome", "running");
-    writer_ = std::thread([this] { writer_loop(); });
+    renderer_ = std::thread([this] { render_loop(); });
+    storer_ = std::thread([this] { store_loop(); });
 }
 
 TraceFile::~TraceFile() {
-    if (db_ != nullptr && writer_.joinable()) {
+    if (db_ != nullptr && renderer_.joinable()) {
         try {
             sync();
         } catch (const std::exception& error) {
@@ -194,36 +206,85 @@ void TraceFile::fail(const std::string& sqlite_error) {
     throw std::runtime_error("trace " + file_.string() + ": " + sqlite_error);
 }
 
-void TraceFile::writer_loop() {
+void TraceFile::keep_writer_error(const std::string& error) {
+    std::lock_guard lock(queue_mutex_);
+    if (writer_error_.empty()) writer_error_ = error;
+}
+
+// Batches rendered and not yet stored, at most: the renderer runs at most this
+// far ahead of SQLite.
+constexpr std::size_t kBatchesInFlight = 2;
+
+void TraceFile::render_loop() {
+    // Named for `top -H` and profiles (at most 15 characters).
+    pthread_setname_np(pthread_self(), "trace-render");
     // Started by a lockstep case's thread on its leased CPU (rig/host/cpu_lease.h):
     // the batches of rows are written beside the loop, not in its chain.
     leave_leased_cpu();
-    // Swapped with the queue's: both keep their capacity, so a steady run
-    // allocates nothing here.
-    std::vector<PendingRow> batch;
-    std::vector<unsigned char> batch_bytes;
+    Batch batch;
     for (;;) {
         {
             std::unique_lock lock(queue_mutex_);
-            writing_ = false;
+            rendering_ = false;
             drained_.notify_all();
             queued_.wait(lock, [this] {
                 return stopping_ || queue_.size() >= kRowsPerWake || (flush_ && !queue_.empty());
             });
-            if (queue_.empty()) return;  // stopping, nothing left
-            batch.swap(queue_);
-            batch_bytes.swap(queue_bytes_);
-            writing_ = true;
+            if (queue_.empty()) {  // stopping, nothing left
+                rendering_ended_ = true;
+                rendered_.notify_all();
+                return;
+            }
+            if (!spare_batches_.empty()) {
+                batch = std::move(spare_batches_.back());
+                spare_batches_.pop_back();
+            }
+            // Swapped with the queue's: both keep their capacity.
+            batch.rows.swap(queue_);
+            batch.bytes.swap(queue_bytes_);
+            rendering_ = true;
         }
         drained_.notify_all();  // room in the queue again
         try {
-            for (const PendingRow& row : batch) write_row(row, batch_bytes);
+            render_batch(batch);
         } catch (const std::exception& error) {
-            std::lock_guard lock(queue_mutex_);
-            if (writer_error_.empty()) writer_error_ = error.what();
+            keep_writer_error(error.what());  // the rows rendered before it are stored
         }
-        batch.clear();
-        batch_bytes.clear();
+        std::unique_lock lock(queue_mutex_);
+        drained_.wait(lock, [this] { return to_store_.size() < kBatchesInFlight; });
+        to_store_.push_back(std::move(batch));
+        rendered_.notify_one();
+        batch = Batch{};
+    }
+}
+
+void TraceFile::store_loop() {
+    pthread_setname_np(pthread_self(), "trace-store");
+    leave_leased_cpu();
+    for (;;) {
+        Batch batch;
+        {
+            std::unique_lock lock(queue_mutex_);
+            rendered_.wait(lock, [this] { return !to_store_.empty() || rendering_ended_; });
+            if (to_store_.empty()) return;  // rendering ended, everything stored
+            batch = std::move(to_store_.front());
+            to_store_.pop_front();
+            storing_ = true;
+        }
+        drained_.notify_all();  // room for the renderer's next batch
+        try {
+            store_batch(batch);
+        } catch (const std::exception& error) {
+            keep_writer_error(error.what());
+        }
+        batch.rows.clear();
+        batch.bytes.clear();
+        {
+            std::lock_guard lock(queue_mutex_);
+            spare_batches_.push_back(std::move(batch));
+            storing_ = false;
+        }
+        drained_.notify_all();
     }
 }
 
@@ -231,24 +292,25 @@ void TraceFile::sync() {
     std::unique_lock lock(queue_mutex_);
     flush_ = true;
     queued_.notify_one();
-    drained_.wait(lock, [this] { return queue_.empty() && !writing_; });
+    drained_.wait(lock, [this] { return queue_.empty() && !rendering_ && to_store_.empty() && !storing_; });
     flush_ = false;
     if (!writer_error_.empty()) throw std::runtime_error(writer_error_);
 }
 
 void TraceFile::stop_writer() noexcept {
-    if (!writer_.joinable()) return;
+    if (!renderer_.joinable()) return;
     {
         std::lock_guard lock(queue_mutex_);
         stopping_ = true;
     }
     queued_.notify_all();
-    writer_.join();
+    renderer_.join();
+    storer_.join();
 }
 
 void TraceFile::set_meta(const std::string& key, const std::string& value) {
     if (db_ == nullptr) throw std::logic_error("trace " + file_.string() + ": set_meta after finish");
-    if (writer_.joinable()) sync();
+    if (renderer_.joinable()) sync();
     sqlite3_stmt* statement = nullptr;
     if (sqlite3_prepare_v2(db_, "INSERT OR REPLACE INTO meta VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
         fail(sqlite3_errmsg(db_));
@@ -272,7 +334,7 @@ std::uint32_t TraceFile::topic_slot(const std::string& topic, const SampleCodec*
     }
     if (db_ == nullptr) throw std::logic_error("trace " + file_.string() + ": topic added after finish");
     // The writer thread reads topics_: grown only while it is idle.
-    if (writer_.joinable()) sync();
+    if (renderer_.joinable()) sync();
     if (codec != nullptr) {
         sqlite3_stmt* statement = nullptr;
         if (sqlite3_prepare_v2(db_, "INSERT INTO sample_types VALUES (?, ?)", -1, &statement, nullptr) != SQLITE_OK) {
@@ -330,37 +392,52 @@ void TraceFile::append_bytes(TimeNs t, int round, std::uint32_t slot, const Samp
     ++rows_;
 }
 
-void TraceFile::write_row(const PendingRow& row, const std::vector<unsigned char>& bytes) {
-    const Topic& topic = topics_[row.slot];
-    const unsigned char* cdr = bytes.data() + row.cdr_offset;
-    std::string rendered;
-    if (row.binary) {
-        try {
-            rendered = topic.codec->json_text(cdr, row.cdr_size);
-        } catch (const std::exception& error) {  // text that is not UTF-8, as the trace always refused
-            throw std::runtime_error("trace " + file_.string() + ": a sample on " + topic.name + " at t_ns " +
-                                     std::to_string(row.t) + ": " + error.what());
+void TraceFile::render_batch(Batch& batch) {
+    if (batch.rendered.size() < batch.rows.size()) batch.rendered.resize(batch.rows.size());
+    for (std::size_t i = 0; i < batch.rows.size(); ++i) {
+        const PendingRow& row = batch.rows[i];
+        const Topic& topic = topics_[row.slot];
+        const unsigned char* cdr = batch.bytes.data() + row.cdr_offset;
+        if (row.binary) {
+            try {
+                batch.rendered[i] = topic.codec->json_text(cdr, row.cdr_size);
+            } catch (const std::exception& error) {  // text that is not UTF-8, as the trace always refused
+                // The rows before it are still stored, as they were when one thread wrote them.
+                batch.rows.erase(batch.rows.begin() + static_cast<std::ptrdiff_t>(i), batch.rows.end());
+                throw std::runtime_error("trace " + file_.string() + ": a sample on " + topic.name + " at t_ns " +
+                                         std::to_string(row.t) + ": " + error.what());
+            }
+            add_sample_digest(digest_, row.t, row.round, topic.name, batch.rendered[i]);
+            add_cdr_digest(cdr_digest_, row.t, row.round, topic.name, cdr, row.cdr_size);
+        } else {
+            add_sample_digest(digest_, row.t, row.round, topic.name, row.json_text);
         }
     }
-    const std::string& text = row.binary ? rendered : row.json_text;
-    add_sample_digest(digest_, row.t, row.round, topic.name, text);
-    sqlite3_bind_int64(insert_, 1, row.t);
-    sqlite3_bind_int(insert_, 2, row.round);
-    sqlite3_bind_text(insert_, 3, topic.name.c_str(), static_cast<int>(topic.name.size()), SQLITE_STATIC);
-    sqlite3_bind_text(insert_, 4, text.c_str(), static_cast<int>(text.size()), SQLITE_STATIC);
-    if (row.binary) {
-        add_cdr_digest(cdr_digest_, row.t, row.round, topic.name, cdr, row.cdr_size);
-        sqlite3_bind_blob(insert_, 5, cdr, static_cast<int>(row.cdr_size), SQLITE_STATIC);
-    } else {
-        sqlite3_bind_null(insert_, 5);
-    }
-    if (sqlite3_step(insert_) != SQLITE_DONE) {
-        fail(sqlite3_errmsg(db_));
-    }
-    sqlite3_reset(insert_);
-    if (++rows_in_batch_ >= kRowsPerBatch) {
-        exec("COMMIT; BEGIN;");
-        rows_in_batch_ = 0;
+}
+
+void TraceFile::store_batch(const Batch& batch) {
+    for (std::size_t i = 0; i < batch.rows.size(); ++i) {
+        const PendingRow& row = batch.rows[i];
+        const Topic& topic = topics_[row.slot];
+        const std::string& text = row.binary ? batch.rendered[i] : row.json_text;
+        sqlite3_bind_int64(insert_, 1, row.t);
+        sqlite3_bind_int(insert_, 2, row.round);
+        sqlite3_bind_text(insert_, 3, topic.name.c_str(), static_cast<int>(topic.name.size()), SQLITE_STATIC);
+        sqlite3_bind_text(insert_, 4, text.c_str(), static_cast<int>(text.size()), SQLITE_STATIC);
+        if (row.binary) {
+            sqlite3_bind_blob(insert_, 5, batch.bytes.data() + row.cdr_offset, static_cast<int>(row.cdr_size),
+                              SQLITE_STATIC);
+        } else {
+            sqlite3_bind_null(insert_, 5);
+        }
+        if (sqlite3_step(insert_) != SQLITE_DONE) {
+            fail(sqlite3_errmsg(db_));
+        }
+        sqlite3_reset(insert_);
+        if (++rows_in_batch_ >= kRowsPerBatch) {
+            exec("COMMIT; BEGIN;");
+            rows_in_batch_ = 0;
+        }
     }
 }
 
@@ -492,6 +569,7 @@ std::string TraceFile::finish(const TraceOutcome& outcome) {
     set_meta("trace_sha256", hex_digest);
     if (cdr_digest_text_.empty()) cdr_digest_text_ = cdr_digest_.hex();
     set_meta("cdr_sha256", cdr_digest_text_);
+    exec(kSamplesIndex);
     exec("COMMIT;");
     sqlite3_finalize(insert_);
     insert_ = nullptr;

@@ -23,14 +23,17 @@
 //
 // Samples are written off the lockstep round's critical path: append_sample()
 // queues the sample's CDR bytes (harness/trace/trace_cdr.h; no text on the
-// loop) and a writer thread of the file's own renders its JSON text from them,
-// digests it and inserts both, in the order queued (so the digest is the
-// same). Every other call first waits for the queue to drain, so the file is
-// only ever touched by one thread at a time; all calls come from the thread
-// that runs the case. A write that fails (a full disk) is reported by the next
-// call, naming the file.
+// loop). Two threads of the file's own take them in the order queued, a batch
+// at a time: one renders each sample's JSON text and adds it to the digests
+// (so the digest is the same), the other inserts the rendered batch into
+// SQLite. Each is about half of the work, so on a machine with a core to
+// spare the two halves overlap (docs/speed.md). Every other call first waits
+// for both to drain, so the file is only ever touched by one thread at a time;
+// all calls come from the thread that runs the case. A write that fails (a
+// full disk) is reported by the next call, naming the file.
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <mutex>
 #include <string>
@@ -161,15 +164,28 @@ private:
         std::string name;
         const SampleCodec* codec = nullptr;
     };
+    // Rows taken off the queue together, with their CDR bytes and, once
+    // rendered, each row's JSON text (a text row's is in the row itself).
+    // Batches are reused: a steady run allocates no new ones.
+    struct Batch {
+        std::vector<PendingRow> rows;
+        std::vector<unsigned char> bytes;
+        std::vector<std::string> rendered;  // per row; empty for a text row
+    };
     void append_bytes(TimeNs t, int round, std::uint32_t slot, const SampleCodec* codec, const void* sample);
     // Waits for room in the queue (under queue_mutex_); throws the writer's error.
     void wait_for_room(std::unique_lock<std::mutex>& lock);
     // Records the first SQLite error (see first_error_), then throws it naming the file.
     [[noreturn]] void fail(const std::string& sqlite_error);
     void exec(const char* sql);
-    // On the writer thread; `bytes` holds binary rows' CDR.
-    void write_row(const PendingRow& row, const std::vector<unsigned char>& bytes);
-    void writer_loop();
+    // On the rendering thread: each row's text, into the digests.
+    void render_batch(Batch& batch);
+    // On the storing thread: the rendered rows into `samples`.
+    void store_batch(const Batch& batch);
+    void render_loop();
+    void store_loop();
+    // Records a thread's error (the first one) for the caller's next call.
+    void keep_writer_error(const std::string& error);
     // Until every queued row is written; throws the writer's error, if any.
     void sync();
     void stop_writer() noexcept;
@@ -188,14 +204,19 @@ private:
     std::string cdr_digest_text_;
     std::string sha256_;       // set once the file is closed
 
-    // The writer thread and its queue (bounded: a slow disk slows the run down
-    // rather than filling memory).
+    // The two writer threads and their queues (bounded: a slow disk slows the
+    // run down rather than filling memory).
     std::mutex queue_mutex_;
-    std::condition_variable queued_;   // rows to write, or stop
-    std::condition_variable drained_;  // the queue emptied, or room in it
+    std::condition_variable queued_;    // rows to render, or stop
+    std::condition_variable rendered_;  // a batch to store, or rendering ended
+    std::condition_variable drained_;   // a thread went idle, or room in a queue
     std::vector<PendingRow> queue_;
     std::vector<unsigned char> queue_bytes_;  // the queued rows' CDR, back to back
-    bool writing_ = false;             // the writer holds rows taken off the queue
+    std::deque<Batch> to_store_;        // rendered, in order
+    std::vector<Batch> spare_batches_;  // stored, their buffers kept
+    bool rendering_ = false;            // the rendering thread holds a batch
+    bool storing_ = false;              // the storing thread holds a batch
+    bool rendering_ended_ = false;      // stopping, and every row rendered
     bool stopping_ = false;
     bool flush_ = false;               // sync() waits: write whatever is queued
     std::string writer_error_;
@@ -203,7 +224,8 @@ private:
     // failed on the caller's thread (a discovery row on a full disk) is caught
     // by the run, and without it finish() could only say "a write failed".
     std::string first_error_;
-    std::thread writer_;
+    std::thread renderer_;
+    std::thread storer_;
 };
 
 }  // namespace rig::harness
