@@ -284,20 +284,51 @@ TEST(Guidance, Seed000ComesBackToTheLineOffsetAfterEachHeadlandTurn) {
 
 TEST(Guidance, TheJudgeTakesTheErrorOverTheMovingSamples) {
     using rig::harness::GuidanceErrorSample;
-    // Standing (0.05 m/s) is left out, however far off: RMS of 3 and -4 cm is
-    // sqrt((9 + 16) / 2) = 3.536 cm, the peak 4 cm; headings 1 and -2 deg: sqrt(2.5).
+    // Standing (0.05 m/s) is left out, however far off. The three are 50 ms
+    // apart: the first stands for 25 ms, the second for 50 ms, so the RMS of 3
+    // and -4 cm is sqrt((25 * 9 + 50 * 16) / 75) = 3.697 cm, the peak 4 cm.
     const rig::harness::MetricSet judged = rig::harness::guidance_metrics(
-        {GuidanceErrorSample{0.03, 1.0, 1.0}, GuidanceErrorSample{-0.04, -2.0, 1.5}, GuidanceErrorSample{1.0, 30.0, 0.05}},
+        {GuidanceErrorSample{0, 0.03, 1.0, 1.0}, GuidanceErrorSample{50'000'000, -0.04, -2.0, 1.5},
+         GuidanceErrorSample{100'000'000, 1.0, 30.0, 0.05}},
         "axle");
-    EXPECT_NEAR(judged.values.at("guidance_axle_cross_track_rms_m"), std::sqrt(0.00125), 1e-15);
+    // Weights 25 and 50 ms: sqrt((25 * 9 + 50 * 16) / 75) cm, sqrt((25 * 1 + 50 * 4) / 75) deg.
+    EXPECT_NEAR(judged.values.at("guidance_axle_cross_track_rms_m"), 0.01 * std::sqrt(1025.0 / 75.0), 1e-15);
     EXPECT_DOUBLE_EQ(judged.values.at("guidance_axle_cross_track_peak_m"), 0.04);
-    EXPECT_NEAR(judged.values.at("guidance_heading_error_rms_deg"), std::sqrt(2.5), 1e-15);
+    EXPECT_NEAR(judged.values.at("guidance_heading_error_rms_deg"), std::sqrt(3.0), 1e-15);
     EXPECT_EQ(judged.values.at("guidance_moving_samples"), 2.0);
     // Never moving: not measured, saying why, rather than a zero error.
     const rig::harness::MetricSet standing =
-        rig::harness::guidance_metrics({GuidanceErrorSample{0.5, 3.0, 0.0}}, "antenna");
+        rig::harness::guidance_metrics({GuidanceErrorSample{0, 0.5, 3.0, 0.0}}, "antenna");
     EXPECT_EQ(standing.values.count("guidance_antenna_cross_track_rms_m"), 0u);
     EXPECT_NE(standing.not_measured.at("guidance_antenna_cross_track_rms_m").find("never moved"), std::string::npos);
+}
+
+// Seed 000's truth/vehicle is a 20 Hz grid plus a sample at every instant the
+// controller published: a burst of those while the vehicle was off the line must
+// not weigh more than the time it lasted, nor any other controller's timing.
+TEST(Guidance, SamplesAtTheControllersInstantsWeighOnlyTheTimeTheyStandFor) {
+    using rig::harness::GuidanceErrorSample;
+    constexpr rig::TimeNs kGrid = 50'000'000;  // 20 Hz
+    std::vector<GuidanceErrorSample> grid;
+    for (int i = 0; i <= 40; ++i) {  // 2 s: 2 cm off for the first second, then on the line
+        grid.push_back(GuidanceErrorSample{i * kGrid, i < 20 ? 0.02 : 0.0, 0.0, 1.0});
+    }
+    const rig::harness::MetricSet on_grid = rig::harness::guidance_metrics(grid, "antenna");
+    // 2 cm over the first 0.975 s of 2 s (the sample at 0.95 s stands to 0.975 s):
+    // sqrt(0.975 / 2) * 2 cm.
+    EXPECT_NEAR(on_grid.values.at("guidance_antenna_cross_track_rms_m"), 0.02 * std::sqrt(0.975 / 2.0), 1e-12);
+    // Ten samples more, 1 ms apart, 10 ms into the off-line second (a controller
+    // publishing in a burst): one sample one vote would be 41 against 10 more.
+    std::vector<GuidanceErrorSample> with_burst = grid;
+    for (int k = 1; k <= 10; ++k) {
+        with_burst.insert(with_burst.begin() + k, GuidanceErrorSample{k * 1'000'000, 0.02, 0.0, 1.0});
+    }
+    const rig::harness::MetricSet judged = rig::harness::guidance_metrics(with_burst, "antenna");
+    EXPECT_NEAR(judged.values.at("guidance_antenna_cross_track_rms_m"),
+                on_grid.values.at("guidance_antenna_cross_track_rms_m"), 1e-12);
+    EXPECT_EQ(judged.values.at("guidance_moving_samples"), 51.0);
+    // (Counted one a sample, the burst would have made it sqrt(30 / 51) * 2 cm =
+    // 1.53 cm instead of sqrt(0.975 / 2) * 2 cm = 1.40 cm.)
 }
 
 }  // namespace

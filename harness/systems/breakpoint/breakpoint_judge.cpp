@@ -304,6 +304,7 @@ SystemJudgement judge_breakpoint_trace(const RecordedTrace& trace, const Breakpo
         std::vector<GuidanceErrorSample> errors;
         for (const RecordedSample& sample : trace.samples(topics::kVehicleTruth)) {
             errors.push_back(GuidanceErrorSample{
+                sample.t_ns,
                 sample.json.at("cross_m").get<double>(),
                 std::remainder(sample.json.at("heading_deg").get<double>() - plan.field_heading_deg, 360.0),
                 sample.json.at("speed_m_s").get<double>()});
