@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -271,6 +273,43 @@ CameraEmulatorParams seed001_camera_params(bool right_camera) {
     return params;
 }
 
+std::shared_ptr<const CameraEmulator::CornerRays> CameraEmulator::corner_rays_of(
+    const rig::camera::PinholeCamera& camera, const rig::camera::BrownConradyDistortion& distortion) {
+    // The lens, exactly: a table is reused only for the same numbers, so a
+    // frame's bytes never depend on which camera built it.
+    const rig::camera::CameraIntrinsics& k = camera.model().intrinsics;
+    const std::array<double, 11> lens{static_cast<double>(k.width_px), static_cast<double>(k.height_px), k.fx_px, k.fy_px,
+                                      k.cx_px, k.cy_px, distortion.k1, distortion.k2, distortion.k3, distortion.p1,
+                                      distortion.p2};
+    // The last few lenses built (a table is 16 MB at 1280 x 720); cases built
+    // at once on several threads wait for one another here, not for long.
+    static std::mutex mutex;
+    static std::vector<std::pair<std::array<double, 11>, std::shared_ptr<const CornerRays>>> built;
+    constexpr std::size_t kLensesKept = 2;
+    const std::lock_guard lock(mutex);
+    for (const auto& [key, table] : built) {
+        if (std::memcmp(key.data(), lens.data(), sizeof lens) == 0) return table;
+    }
+    auto table = std::make_shared<CornerRays>();
+    const int width = k.width_px;
+    const int height = k.height_px;
+    table->ray.resize(static_cast<std::size_t>(width + 1) * static_cast<std::size_t>(height + 1));
+    table->valid.resize(table->ray.size(), 0);
+    for (int v = 0; v <= height; ++v) {
+        for (int u = 0; u <= width; ++u) {
+            const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(width + 1) + static_cast<std::size_t>(u);
+            const auto normalized =
+                rig::camera::undistort_normalized(distortion, camera.pixel_to_distorted_normalized(Eigen::Vector2d(u, v)));
+            if (!normalized) continue;
+            table->ray[i] = *normalized;
+            table->valid[i] = 1;
+        }
+    }
+    if (built.size() == kLensesKept) built.erase(built.begin());
+    built.emplace_back(lens, table);
+    return table;
+}
+
 CameraEmulator::CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, std::uint64_t stream, std::string name)
     : params_((validate(params, name), std::move(params))),
       noise_key_(rig::field2d::hash_key(seed, 0xca3e7a00ULL, stream)),
@@ -278,31 +317,22 @@ CameraEmulator::CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, 
       camera_(with_pitch_fault(params_.camera, params_.faults.pitch_offset_deg), name_) {
     const int width = camera_.width_px();
     const int height = camera_.height_px();
-    corner_rays_.resize(static_cast<std::size_t>(width + 1) * static_cast<std::size_t>(height + 1));
-    corner_ray_valid_.resize(corner_rays_.size(), 0);
-    for (int v = 0; v <= height; ++v) {
-        for (int u = 0; u <= width; ++u) {
-            const std::size_t i = static_cast<std::size_t>(v) * static_cast<std::size_t>(width + 1) + static_cast<std::size_t>(u);
-            const auto normalized = rig::camera::undistort_normalized(
-                params_.camera.distortion, camera_.pixel_to_distorted_normalized(Eigen::Vector2d(u, v)));
-            if (!normalized) continue;
-            corner_rays_[i] = *normalized;
-            corner_ray_valid_[i] = 1;
-        }
-    }
+    corner_rays_ = corner_rays_of(camera_, params_.camera.distortion);
+    const std::vector<Eigen::Vector2d>& rays = corner_rays_->ray;
+    const std::vector<std::uint8_t>& ray_valid = corner_rays_->valid;
 
     // render()'s fixed part. The boom frame is level, so which corner rays
     // meet the ground depends on the mounting alone, not on the pose.
     const Eigen::Matrix3d& axes = camera_.axes_in_boom();
-    corner_x_.assign(corner_rays_.size(), 0.0F);
-    corner_y_.assign(corner_rays_.size(), 0.0F);
-    std::vector<std::uint8_t> corner_hits(corner_rays_.size(), 0);
-    for (std::size_t i = 0; i < corner_rays_.size(); ++i) {
-        if (corner_ray_valid_[i] == 0) continue;
-        const double down = axes.row(2).dot(Eigen::Vector3d(corner_rays_[i].x(), corner_rays_[i].y(), 1.0));
+    corner_x_.assign(rays.size(), 0.0F);
+    corner_y_.assign(rays.size(), 0.0F);
+    std::vector<std::uint8_t> corner_hits(rays.size(), 0);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (ray_valid[i] == 0) continue;
+        const double down = axes.row(2).dot(Eigen::Vector3d(rays[i].x(), rays[i].y(), 1.0));
         if (down >= -1e-9) continue;  // at or above the horizon, as render_scene() has it
-        corner_x_[i] = static_cast<float>(corner_rays_[i].x());
-        corner_y_[i] = static_cast<float>(corner_rays_[i].y());
+        corner_x_[i] = static_cast<float>(rays[i].x());
+        corner_y_[i] = static_cast<float>(rays[i].y());
         corner_hits[i] = 1;
     }
     const std::size_t stride = static_cast<std::size_t>(width) + 1U;
@@ -684,14 +714,15 @@ std::optional<RgbImage> CameraEmulator::render_scene(const rig::field2d::CropCov
     const Eigen::Vector3d& position = camera_.position_in_boom();
     const Vec2 right_axis = rig::field2d::right_of(pose.heading_deg);
     const Vec2 forward_axis = rig::field2d::forward_of(pose.heading_deg);
-    std::vector<Vec2> corner_ground(corner_rays_.size());
-    std::vector<Vec2> corner_boom_plane(boom_plane != nullptr ? corner_rays_.size() : 0);
-    std::vector<Vec2> corner_ground_boom(ground != nullptr ? corner_rays_.size() : 0);
-    std::vector<std::uint8_t> corner_hits(corner_rays_.size(), 0);
+    const std::vector<Eigen::Vector2d>& rays = corner_rays_->ray;
+    std::vector<Vec2> corner_ground(rays.size());
+    std::vector<Vec2> corner_boom_plane(boom_plane != nullptr ? rays.size() : 0);
+    std::vector<Vec2> corner_ground_boom(ground != nullptr ? rays.size() : 0);
+    std::vector<std::uint8_t> corner_hits(rays.size(), 0);
     const double drop = -pose.boom_height_m - position.z();
-    for (std::size_t i = 0; i < corner_rays_.size(); ++i) {
-        if (corner_ray_valid_[i] == 0) continue;
-        const Eigen::Vector3d direction = axes * Eigen::Vector3d(corner_rays_[i].x(), corner_rays_[i].y(), 1.0);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (corner_rays_->valid[i] == 0) continue;
+        const Eigen::Vector3d direction = axes * Eigen::Vector3d(rays[i].x(), rays[i].y(), 1.0);
         if (direction.z() >= -1e-9) continue;  // at or above the horizon
         const double scale = drop / direction.z();
         const double x = position.x() + scale * direction.x();

@@ -41,6 +41,7 @@
 //   dead              black_frame (a sensor that delivers zeros) or no_frame
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -200,9 +201,16 @@ private:
     std::string name_;
     rig::camera::PinholeCamera camera_;
     // Undistorted normalised rays at the pixel corners, (width + 1) x (height + 1):
-    // a pixel's footprint is the ground between its four corners' rays.
-    std::vector<Eigen::Vector2d> corner_rays_;
-    std::vector<std::uint8_t> corner_ray_valid_;
+    // a pixel's footprint is the ground between its four corners' rays. They
+    // depend on the lens alone (intrinsics, distortion), so cameras with the
+    // same lens share one table: both of a case's, and the next case's.
+    struct CornerRays {
+        std::vector<Eigen::Vector2d> ray;
+        std::vector<std::uint8_t> valid;
+    };
+    static std::shared_ptr<const CornerRays> corner_rays_of(const rig::camera::PinholeCamera& camera,
+                                                            const rig::camera::BrownConradyDistortion& distortion);
+    std::shared_ptr<const CornerRays> corner_rays_;
     // The same rays for render() in single precision, split by axis (zero
     // where a pixel sees no ground); the pixels whose four corner rays do not
     // all meet the ground (255: sky) and whether there are any; the corners on
