@@ -31,6 +31,7 @@
 #include <memory>
 #include <vector>
 
+#include "emulators/field2d/leaf_raster.h"
 #include "emulators/field2d/polygon.h"
 #include "emulators/field2d/vec2.h"
 
@@ -79,11 +80,11 @@ void validate(const CropCoverParams& params);
 
 class CropCoverMap {
 public:
-    // The truth raster's cell size.
-    static constexpr double kCellM = 0.001;
+    // The truth raster's cell size (emulators/field2d/leaf_raster.h).
+    static constexpr double kCellM = kRasterCellM;
     // A plant cell's value in copy_cells() (soil is 0): full scale of an
     // 8-bit cover image, so a bilinear sample of it reads as cover x 255.
-    static constexpr std::uint8_t kPlantCell = 255;
+    static constexpr std::uint8_t kPlantCell = kRasterPlantCell;
 
     // Throws std::invalid_argument as validate() does.
     CropCoverMap(CropCoverParams params, std::uint64_t seed);

@@ -9,16 +9,18 @@ namespace rig::field2d {
 
 namespace {
 
-// The raster's cell, as CropCoverMap::kCellM (1 mm).
-constexpr double kCellM = 0.001;
+constexpr double kCellM = kRasterCellM;
 // draw_leaf()'s margin between a leaf's surely-inside and surely-outside cells
 // (rounding is some 1e-16 m here, away from kFlat).
 constexpr double kSureM = 1e-9;
 // A leaf within this (as a slope) of square to an axis has that condition of
 // its rectangle independent of x (its bounds would be past 1e9 m).
 constexpr double kFlat = 1e-12;
+// 1 / kCellM, written out: a multiplication by it, where the code has one,
+// is not the same rounding as a division by kCellM.
 constexpr double kCellsPerM = 1000.0;
-constexpr std::uint8_t kPlantCell = 255;
+static_assert(kCellsPerM * kCellM == 1.0);
+constexpr std::uint8_t kPlantCell = kRasterPlantCell;
 
 // floor() of a value held within [low, high] first (so it fits an int, and
 // truncation and a correction give the floor without a libm call on the

@@ -9,6 +9,11 @@
 
 namespace rig::field2d {
 
+// The raster's cell, 1 mm, and the value a plant cell holds in a block (soil
+// is 0): CropCoverMap::kCellM and kPlantCell are these.
+inline constexpr double kRasterCellM = 0.001;
+inline constexpr std::uint8_t kRasterPlantCell = 255;
+
 // The centre of raster cell i along an axis, in metres (cell i spans i to i + 1 mm).
 double cell_centre_m(std::int64_t i);
 
