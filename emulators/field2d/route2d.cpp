@@ -19,13 +19,6 @@ void require_positive(std::size_t index, const char* what, double value) {
     }
 }
 
-double wrap_deg(double deg) {
-    double wrapped = std::fmod(deg, 360.0);
-    if (wrapped < 0.0) wrapped += 360.0;
-    if (wrapped >= 360.0) wrapped -= 360.0;
-    return wrapped;
-}
-
 }  // namespace
 
 std::vector<Route2d::Piece> Route2d::speed_profile(std::size_t index, double entry_speed_m_s, double length_m,
@@ -97,7 +90,7 @@ Route2d::Route2d(RouteStart start, std::vector<RouteSegment> segments) : start_(
     double distance = 0.0;
     double speed = start.speed_m_s;
     Vec2 position = start.position;
-    double heading = wrap_deg(start.heading_deg);
+    double heading = heading_0_360_deg(start.heading_deg);
     for (std::size_t i = 0; i < segments.size(); ++i) {
         Compiled c;
         c.start_s = t;
@@ -179,7 +172,7 @@ void Route2d::place(const Compiled& segment, double distance_m, Vec2& position, 
     const Vec2 centre = segment.start_position + (sign * radius) * right_of(h0);
     const double h = h0 + sign * (distance_m / radius) / kRadPerDeg;
     position = centre - (sign * radius) * right_of(h);
-    heading_deg = wrap_deg(h);
+    heading_deg = heading_0_360_deg(h);
 }
 
 Route2d::Along Route2d::along(const Compiled& segment, double into_s) {
@@ -204,7 +197,7 @@ VehiclePose2d Route2d::state_at(double t_s) const {
     const double end_s = end_time_s();
     if (segments_.empty() || t >= end_s) {
         pose.position = segments_.empty() ? start_.position : end_position_;
-        pose.heading_deg = segments_.empty() ? wrap_deg(start_.heading_deg) : end_heading_deg_;
+        pose.heading_deg = segments_.empty() ? heading_0_360_deg(start_.heading_deg) : end_heading_deg_;
         pose.speed_m_s = 0.0;
         pose.distance_m = total_distance_m();
         pose.segment = segments_.size();

@@ -45,6 +45,19 @@ inline Vec2 right_of(double heading_deg) {
 inline Vec2 body_to_field(Vec2 origin, double heading_deg, double right_m, double forward_m) {
     return origin + right_m * right_of(heading_deg) + forward_m * forward_of(heading_deg);
 }
+// A compass heading brought into [0, 360). std::fmod is exact; adding 360
+// to a negative remainder may round up to 360 itself, which is 0.
+inline double heading_0_360_deg(double deg) {
+    double wrapped = std::fmod(deg, 360.0);
+    if (wrapped < 0.0) wrapped += 360.0;
+    if (wrapped >= 360.0) wrapped -= 360.0;
+    return wrapped;
+}
+// The turn from heading b to heading a, in (-180, 180] (exact: std::remainder).
+inline double heading_difference_deg(double a_deg, double b_deg) {
+    const double wrapped = std::remainder(a_deg - b_deg, 360.0);
+    return wrapped == -180.0 ? 180.0 : wrapped;
+}
 // Compass bearing of a direction, in [0, 360).
 inline double bearing_deg(Vec2 direction) {
     double deg = std::atan2(direction.east_m, direction.north_m) * 180.0 / M_PI;

@@ -14,17 +14,6 @@ namespace {
 
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
-double wrapped_180(double deg) {
-    const double wrapped = std::remainder(deg, 360.0);
-    return wrapped == -180.0 ? 180.0 : wrapped;
-}
-
-double wrapped_360(double deg) {
-    double wrapped = std::fmod(deg, 360.0);
-    if (wrapped < 0.0) wrapped += 360.0;
-    return wrapped >= 360.0 ? 0.0 : wrapped;
-}
-
 // Body point (right, forward) of a body at `origin` facing `heading_deg`.
 Vec2 on_ground(Vec2 origin, double heading_deg, const BodyPoint& point) {
     return field2d::body_to_field(origin, heading_deg, point.right_m, point.forward_m);
@@ -146,7 +135,7 @@ GuidedPath::GuidedPath(const GuidanceParams& params, ReferencePath route, SpeedP
         const double yaw_disturbance_rad_m = yaw.at(foot_m) * kRadPerDeg;
         sample.yaw_rate_deg_s = sample.speed_m_s * (std::tan(steer_rad) / wheelbase_m + yaw_disturbance_rad_m) / kRadPerDeg;
         sample.cross_track_m = field2d::dot(position - foot.position, field2d::right_of(foot.heading_deg));
-        sample.heading_error_deg = wrapped_180(heading_deg - foot.heading_deg);
+        sample.heading_error_deg = field2d::heading_difference_deg(heading_deg, foot.heading_deg);
         sample.route_distance_m = foot_m;
         const BodyPoint antenna_now = tilted(antenna, sample.roll_deg, sample.pitch_deg);
         sample.antenna = on_ground(position, heading_deg, antenna_now);
@@ -183,7 +172,7 @@ GuidedState GuidedPath::state_at(double t_s) const {
                             ? lerp(samples_[below], samples_[below + 1], steps - static_cast<double>(below))
                             : samples_.back();
     state.time_s = t_s;
-    state.heading_deg = wrapped_360(state.heading_deg);
+    state.heading_deg = field2d::heading_0_360_deg(state.heading_deg);
     return state;
 }
 

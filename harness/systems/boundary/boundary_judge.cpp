@@ -429,7 +429,7 @@ std::vector<GuidanceErrorSample> guidance_errors(const RecordedTrace& trace,
         GuidanceErrorSample error;
         error.t_ns = s.t_ns;
         error.cross_track_m = field2d::dot(axle - field2d::Vec2{at[0], at[1]}, field2d::right_of(at[2]));
-        error.heading_error_deg = std::remainder(s.json.at("heading_deg").get<double>() - at[2], 360.0);
+        error.heading_error_deg = field2d::heading_difference_deg(s.json.at("heading_deg").get<double>(), at[2]);
         error.speed_m_s = s.json.at("speed_m_s").get<double>();
         errors.push_back(error);
     }
