@@ -33,6 +33,9 @@ int floor_within(double value, int low, int high) {
 
 int ceil_within(double value, int low, int high) { return -floor_within(-value, -high, -low); }
 
+// A cell index within a block's row (first_centre_past() keeps it in [first, end]).
+int within_row(std::int64_t index) { return static_cast<int>(index); }
+
 // Squared distance from p to the segment a-b.
 double segment_distance_sq(double px, double py, double ax, double ay, double bx, double by) {
     const double dx = bx - ax;
@@ -120,30 +123,17 @@ struct Capsule {
     }
 };
 
-// first_centre_past() within a block's row (a few hundred cells), without
-// floor (a libm call on the baseline x86-64 target): truncation's guess is at
-// most a cell off, and the walk puts it right.
-int centre_index_past(double x_m, int first, int end, CentrePast rule) {
-    // A guess only (a product, not a quotient: the walk below ends on the
-    // first centre past x_m from wherever it starts in [first, end]).
-    const double scaled = std::clamp(x_m * kCellsPerM - 0.5, static_cast<double>(first), static_cast<double>(end));
-    auto i = static_cast<int>(scaled);
-    auto past = [&](int k) {
-        const double centre = (static_cast<double>(k) + 0.5) * kCellM;
-        return rule == CentrePast::strictly_right ? centre > x_m : centre >= x_m;
-    };
-    while (i > first && past(i - 1)) --i;
-    while (i < end && !past(i)) ++i;
-    return i;
-}
-
 }  // namespace
 
 double cell_centre_m(std::int64_t i) { return (static_cast<double>(i) + 0.5) * kCellM; }
 
 std::int64_t first_centre_past(double x_m, std::int64_t first, std::int64_t end, CentrePast rule) {
-    const double guess = std::clamp(std::floor(x_m / kCellM - 0.5), static_cast<double>(first), static_cast<double>(end));
-    auto i = static_cast<std::int64_t>(guess);
+    // A guess only, from a product and a truncation (no floor, a libm call on
+    // the baseline x86-64 target; draw_leaf() asks this per row): at most a
+    // cell off, and the walk below ends on the first centre past x_m from
+    // wherever it starts in [first, end].
+    const double scaled = std::clamp(x_m * kCellsPerM - 0.5, static_cast<double>(first), static_cast<double>(end));
+    auto i = static_cast<std::int64_t>(scaled);
     auto past = [&](std::int64_t k) { return rule == CentrePast::strictly_right ? cell_centre_m(k) > x_m : cell_centre_m(k) >= x_m; };
     while (i > first && past(i - 1)) --i;
     while (i < end && !past(i)) ++i;
@@ -184,8 +174,8 @@ void draw_leaf(std::uint8_t* cells, int side, const LeafStrip& leaf) {
         };
         // The run's ends among the cells: maybe.low <= centre, then sure.low <
         // centre < sure.high, then centre <= maybe.high.
-        const int maybe_first = centre_index_past(maybe.low, i_first, i_end, CentrePast::at_or_right);
-        const int maybe_end = std::max(maybe_first, centre_index_past(maybe.high, i_first, i_end, CentrePast::strictly_right));
+        const int maybe_first = within_row(first_centre_past(maybe.low, i_first, i_end, CentrePast::at_or_right));
+        const int maybe_end = std::max(maybe_first, within_row(first_centre_past(maybe.high, i_first, i_end, CentrePast::strictly_right)));
         if (!(sure.low < sure.high)) {
             exact(maybe_first, maybe_end);
             continue;
@@ -196,10 +186,10 @@ void draw_leaf(std::uint8_t* cells, int side, const LeafStrip& leaf) {
         // sure.high (so none before maybe_end reaches it); only else walk.
         const bool starts_sure = maybe_first == i_end || cell_centre_m(maybe_first) > sure.low;
         const int sure_first =
-            starts_sure ? maybe_first : std::max(maybe_first, centre_index_past(sure.low, i_first, i_end, CentrePast::strictly_right));
+            starts_sure ? maybe_first : std::max(maybe_first, within_row(first_centre_past(sure.low, i_first, i_end, CentrePast::strictly_right)));
         const bool ends_sure = maybe_end > sure_first && cell_centre_m(maybe_end - 1) < sure.high;
         const int sure_end = ends_sure ? maybe_end
-                                       : std::min(maybe_end, std::max(sure_first, centre_index_past(sure.high, i_first, i_end, CentrePast::at_or_right)));
+                                       : std::min(maybe_end, std::max(sure_first, within_row(first_centre_past(sure.high, i_first, i_end, CentrePast::at_or_right))));
         exact(maybe_first, sure_first);
         if (sure_end > sure_first) std::memset(row + sure_first, kPlantCell, static_cast<std::size_t>(sure_end - sure_first));
         exact(sure_end, maybe_end);
