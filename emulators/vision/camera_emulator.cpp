@@ -273,11 +273,11 @@ CameraEmulatorParams seed001_camera_params(bool right_camera) {
     return params;
 }
 
-std::shared_ptr<const CameraEmulator::CornerRays> CameraEmulator::corner_rays_of(
-    const rig::camera::PinholeCamera& camera, const rig::camera::BrownConradyDistortion& distortion) {
+std::shared_ptr<const CameraEmulator::CornerRays> CameraEmulator::corner_rays_of(const rig::camera::PinholeCamera& camera) {
     // The lens, exactly: a table is reused only for the same numbers, so a
     // frame's bytes never depend on which camera built it.
     const rig::camera::CameraIntrinsics& k = camera.model().intrinsics;
+    const rig::camera::BrownConradyDistortion& distortion = camera.model().distortion;
     const std::array<double, 11> lens{static_cast<double>(k.width_px), static_cast<double>(k.height_px), k.fx_px, k.fy_px,
                                       k.cx_px, k.cy_px, distortion.k1, distortion.k2, distortion.k3, distortion.p1,
                                       distortion.p2};
@@ -317,7 +317,7 @@ CameraEmulator::CameraEmulator(CameraEmulatorParams params, std::uint64_t seed, 
       camera_(with_pitch_fault(params_.camera, params_.faults.pitch_offset_deg), name_) {
     const int width = camera_.width_px();
     const int height = camera_.height_px();
-    corner_rays_ = corner_rays_of(camera_, params_.camera.distortion);
+    corner_rays_ = corner_rays_of(camera_);
     const std::vector<Eigen::Vector2d>& rays = corner_rays_->ray;
     const std::vector<std::uint8_t>& ray_valid = corner_rays_->valid;
 

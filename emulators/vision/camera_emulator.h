@@ -208,8 +208,7 @@ private:
         std::vector<Eigen::Vector2d> ray;
         std::vector<std::uint8_t> valid;
     };
-    static std::shared_ptr<const CornerRays> corner_rays_of(const rig::camera::PinholeCamera& camera,
-                                                            const rig::camera::BrownConradyDistortion& distortion);
+    static std::shared_ptr<const CornerRays> corner_rays_of(const rig::camera::PinholeCamera& camera);
     std::shared_ptr<const CornerRays> corner_rays_;
     // The same rays for render() in single precision, split by axis (zero
     // where a pixel sees no ground); the pixels whose four corner rays do not

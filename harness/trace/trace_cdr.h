@@ -3,8 +3,9 @@
 // first, exactly as DDS carries it (docs/trace-format.md, `samples.cdr`).
 //
 // The lockstep loop only serializes each sample it records (a copy of a few
-// dozen bytes, no text); the trace's writer thread renders the JSON text from
-// those bytes (the digest is taken over that text, as before) and stores both;
+// dozen bytes, no text); the trace's rendering thread renders the JSON text from
+// those bytes (the digest is taken over that text, as before) and its storing
+// thread stores both;
 // the judge decodes the bytes straight into JSON values, with no text to parse.
 // Rendering text and parsing it back took about 5 % of a case's CPU in process
 // (nlohmann's lexer and dtoa), most of it on the loop's thread.

@@ -72,8 +72,8 @@ struct TraceOutcome {
 // reader recomputes them: harness/trace/trace_reader.h), one per row:
 // "t_ns round topic json\n", "deposition pass row nozzle dose\n" (the dose
 // as nlohmann::json::dump() writes a double), "landing t_ns 0|1\n". Added
-// piece by piece, with no line built in between (the writer thread adds one
-// per sample).
+// piece by piece, with no line built in between (the rendering thread adds
+// one per sample).
 void add_sample_digest(Sha256& digest, TimeNs t, int round, std::string_view topic, std::string_view json_text);
 void add_deposition_digest(Sha256& digest, int pass, std::size_t row, int nozzle, double dose_ul_cm2);
 void add_landing_digest(Sha256& digest, TimeNs t, bool landing);
@@ -123,7 +123,7 @@ public:
     // another codec for it throws std::logic_error.
     std::uint32_t topic_slot(const std::string& topic, const SampleCodec* codec = nullptr);
     // A sample of a topic whose slot has `Msg`'s codec. Only its CDR bytes are
-    // made here; the writer thread renders its JSON text.
+    // made here; the rendering thread renders its JSON text.
     template <class Msg>
     void append_sample(TimeNs t, int round, std::uint32_t slot, const Msg& sample) {
         append_bytes(t, round, slot, &sample_codec<Msg>(), &sample);
@@ -195,7 +195,7 @@ private:
     sqlite3_stmt* insert_ = nullptr;
     Sha256 digest_;
     Sha256 cdr_digest_;
-    // Slot -> topic; grown only while the writer thread is idle (after sync()).
+    // Slot -> topic; grown only while both writer threads are idle (after sync()).
     std::vector<Topic> topics_;
     std::uint64_t rows_ = 0;
     std::uint64_t rows_in_batch_ = 0;

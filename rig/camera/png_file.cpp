@@ -24,8 +24,9 @@ void write_png(const std::string& path, const RgbImage& image) {
     png.height = static_cast<png_uint_32>(image.height);
     png.format = PNG_FORMAT_RGB;
     // Speed over size: a camera frame's noise leaves zlib little to find, so its
-    // default effort bought a file only 12 % smaller at nearly twice the time
-    // (two frames per vision case, for its report; docs/seed001-vision.md).
+    // default effort bought a file only 12 % smaller, at a cost the vision
+    // cases' wall time showed (two frames per case, for its report;
+    // docs/seed001-vision.md, "Start-up and the report's frames").
     png.flags = PNG_IMAGE_FLAG_FAST;
     if (png_image_write_to_file(&png, path.c_str(), 0, image.bytes.data(), 0, nullptr) == 0) {
         const std::string message = png.message;
